@@ -1,0 +1,663 @@
+# cython: language_level=3
+"""aftmesh's compiled kernel.
+
+Three layers (see ARCHITECTURE.md): the Python package validates input and builds the
+result; this file is the thin ``def`` layer on typed memoryviews; the included parts
+hold the ``nogil`` kernels:
+
+* predicates.pxi     exact orient2d / incircle behind a floating-point filter
+* triangulation.pxi  half-edge storage, flips, point location, point insertion
+* cdt.pxi            constrained edges (Cline & Renka) and flood fills
+* sizing.pxi         the compiled size field (background grid)
+* front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
+
+Every kernel routine returns a status code (0 or a count on success, a negative ERR_*
+from halfedge.pxd on failure); the methods here turn codes into exceptions.
+"""
+from halfedge cimport *
+
+import numpy as np
+
+cdef extern from *:
+    # set by setup.py: 1 in the debug build (AFTMESH_DEBUG=1), else 0
+    int AFTMESH_DEBUG_BUILD "AFTMESH_DEBUG"
+
+DEBUG = bool(AFTMESH_DEBUG_BUILD)
+
+include "predicates.pxi"
+include "triangulation.pxi"
+include "cdt.pxi"
+include "sizing.pxi"
+include "front.pxi"
+
+
+class KernelError(RuntimeError):
+    """An internal invariant of the kernel broke (a bug in aftmesh, not in the input)."""
+
+
+class CrossingError(ValueError):
+    """A constrained edge would cross another one; ``edge`` and ``blocker`` give the
+    vertex pairs (kernel vertex indices) of the new edge and of the edge it hit."""
+
+    def __init__(self, msg, edge, blocker):
+        super().__init__(msg)
+        self.edge = edge
+        self.blocker = blocker
+
+
+class CollinearError(ValueError):
+    """All points lie on one line, so they have no triangulation."""
+
+
+cdef object _raise_for(Tri* T, int code):
+    if code >= 0:
+        return
+    if code == ERR_NOMEM:
+        raise MemoryError("aftmesh kernel: out of memory")
+    if code == ERR_CROSSING:
+        raise CrossingError(
+            f"edge ({T.err_a}, {T.err_b}) crosses constrained edge ({T.err_u}, {T.err_v})",
+            (T.err_a, T.err_b), (T.err_u, T.err_v))
+    if code == ERR_COLLINEAR:
+        raise CollinearError("all input points are collinear: there is no triangle")
+    if code == ERR_INTERRUPTED:
+        raise KeyboardInterrupt()
+    raise KernelError(f"aftmesh kernel: internal invariant broken (code {code})")
+
+
+cdef double _twice_area(Tri* T, int t):
+    cdef double* a = P(T, T.tv[3 * t])
+    cdef double* b = P(T, T.tv[3 * t + 1])
+    cdef double* c = P(T, T.tv[3 * t + 2])
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+cdef tuple _centroid(Tri* T, int t):
+    cdef double* a = P(T, T.tv[3 * t])
+    cdef double* b = P(T, T.tv[3 * t + 1])
+    cdef double* c = P(T, T.tv[3 * t + 2])
+    return ((a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0)
+
+
+cdef class Triangulation:
+    """A triangulation of a point set with constrained edges, held in flat arrays.
+
+    Vertex k of the kernel is row k of the points given to the constructor; points
+    added later (Basic_aft's new vertices) get the following indices.
+    """
+    cdef Tri T
+    cdef Aft A
+    cdef int vis_edge           # the (edge, R) that check_visible last answered for
+    cdef double vis_R[2]
+
+    def __cinit__(self, const double[:, ::1] points, int nt_hint=0):
+        cdef int n = points.shape[0], i
+        if points.shape[1] != 2:
+            raise ValueError("points must have shape (n, 2)")
+        if tri_init(&self.T, n + 16, max(nt_hint, 2 * n + 16)) or aft_init(&self.A):
+            raise MemoryError()
+        self.vis_edge = NONE
+        with nogil:
+            for i in range(n):
+                add_vertex(&self.T, points[i, 0], points[i, 1])
+
+    def __dealloc__(self):
+        aft_free(&self.A)
+        tri_free(&self.T)
+
+    @property
+    def n_vertices(self):
+        return self.T.nv
+
+    def insert_points(self, const int32_t[::1] order):
+        """Insert the vertices in `order` (a spatially coherent order makes the walks
+        short).  Returns an int32 array `merged`: merged[v] == v for inserted vertices,
+        or the index of the earlier vertex at exactly the same place."""
+        cdef int n = self.T.nv, i, k, v, first, second = NONE, third = NONE, res = 0, pos
+        cdef int m = order.shape[0]
+        merged_arr = np.arange(n, dtype=np.int32)
+        cdef int32_t[::1] merged = merged_arr
+        cdef Tri* T = &self.T
+        if m == 0:
+            return merged_arr
+        with nogil:
+            # pick a non-degenerate first triangle: the first point, the next distinct
+            # one, and the next one off their line
+            first = order[0]
+            for i in range(1, m):
+                v = order[i]
+                if T.xy[2 * v] != T.xy[2 * first] or T.xy[2 * v + 1] != T.xy[2 * first + 1]:
+                    if second == NONE:
+                        second = v
+                    elif orient2d(P(T, first), P(T, second), P(T, v)) != 0:
+                        third = v
+                        break
+            if third == NONE:
+                res = ERR_COLLINEAR
+            else:
+                res = make_first_triangle(T, first, second, third)
+            if res == 0:
+                for i in range(m):
+                    v = order[i]
+                    if v == first or v == second or v == third:
+                        continue
+                    pos = insert_vertex(T, v, NONE)
+                    if pos < 0:
+                        res = pos
+                        break
+                    merged[v] = pos
+        _raise_for(T, res)
+        return merged_arr
+
+    def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT):
+        """Insert constrained edges (pairs of vertex indices).  On a crossing, raises
+        CrossingError with `index` set to the row that failed."""
+        cdef int i, res = 0, failed = -1
+        cdef int m = segments.shape[0]
+        cdef Tri* T = &self.T
+        with nogil:
+            for i in range(m):
+                res = insert_segment(T, segments[i, 0], segments[i, 1], <uint8_t> flag)
+                if res < 0:
+                    failed = i
+                    break
+        try:
+            _raise_for(T, res)
+        except CrossingError as err:
+            err.index = failed
+            raise
+
+    def carve(self, const double[:, ::1] holes, bint from_hull=True):
+        """Mark as exterior the triangles reachable without crossing a segment from the
+        ghost triangles (if `from_hull`) and from each hole point."""
+        cdef Tri* T = &self.T
+        cdef int t, n = 0, res = 0, i, where = NONE, loc
+        with nogil:
+            if reserve_stack(T, T.nt):
+                res = ERR_NOMEM
+            else:
+                for t in range(T.nt):
+                    if T.tstate[t] != T_FREE and is_ghost(T, t):
+                        if from_hull:
+                            T.stack[n] = t
+                            n += 1
+                        else:
+                            T.tstate[t] = T_EXTERIOR
+                res = flood(T, n, T_UNMESHED, T_EXTERIOR, 0, False)
+            for i in range(holes.shape[0]):
+                if res < 0:
+                    break
+                loc = locate(T, &holes[i, 0], NONE, &where)
+                if loc == LOC_IN_TRIANGLE:
+                    T.stack[0] = where
+                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
+                elif loc == LOC_ON_EDGE:
+                    T.stack[0] = where // 3
+                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
+                elif loc < 0:
+                    res = loc
+        _raise_for(T, res)
+
+    def assign_regions(self, const double[:, ::1] seeds, const int32_t[::1] ids):
+        """Give region id ids[k] to every domain triangle reachable from seeds[k]
+        without crossing a segment (later seeds win)."""
+        cdef Tri* T = &self.T
+        cdef int i, res = 0, where = NONE, loc, t, k, sp
+        with nogil:
+            for i in range(seeds.shape[0]):
+                loc = locate(T, &seeds[i, 0], NONE, &where)
+                if loc == LOC_IN_TRIANGLE:
+                    t = where
+                elif loc == LOC_ON_EDGE:
+                    t = where // 3
+                elif loc < 0:
+                    res = loc
+                    break
+                else:
+                    continue
+                if T.tstate[t] != T_UNMESHED:
+                    continue
+                # flood by a temporary state so that region boundaries need no marker
+                T.stack[0] = t
+                res = flood(T, 1, T_UNMESHED, T_MESHED, ids[i], True)
+                if res < 0:
+                    break
+                for t in range(T.nt):
+                    if T.tstate[t] == T_MESHED:
+                        T.tstate[t] = T_UNMESHED
+        _raise_for(T, res)
+
+    def components(self):
+        """Split the domain triangles into the pieces that segments separate.
+
+        Returns (comp, probe): comp[t] is the piece of triangle slot t (-1 if t is not
+        a domain triangle) and probe[c] = (x, y) a point well inside piece c: the
+        centroid of its triangle with the largest area, so that classifying probe[c]
+        against the user's polygons classifies the whole piece."""
+        cdef Tri* T = &self.T
+        cdef int t, k, e, u, sp, nc = 0
+        cdef double area
+        comp_arr = np.full(T.nt, -1, dtype=np.int32)
+        cdef int32_t[::1] comp = comp_arr
+        best = []
+        if reserve_stack(T, T.nt + 1):
+            raise MemoryError()
+        for t in range(T.nt):
+            if T.tstate[t] != T_UNMESHED or comp[t] >= 0:
+                continue
+            best_area = -1.0
+            best_xy = (0.0, 0.0)
+            comp[t] = nc
+            T.stack[0] = t
+            sp = 1
+            while sp > 0:
+                sp -= 1
+                u = T.stack[sp]
+                area = _twice_area(T, u)
+                if area > best_area:
+                    best_area = area
+                    best_xy = _centroid(T, u)
+                for k in range(3):
+                    e = 3 * u + k
+                    if T.eflag[e] & E_SEGMENT:
+                        continue
+                    e = T.twin[e] // 3
+                    if T.tstate[e] == T_UNMESHED and comp[e] < 0:
+                        comp[e] = nc
+                        T.stack[sp] = e
+                        sp += 1
+            best.append(best_xy)
+            nc += 1
+        return comp_arr, np.array(best, dtype=np.float64).reshape(-1, 2)
+
+    def set_regions(self, const int32_t[::1] comp, const int32_t[::1] region_of_comp):
+        """Give every domain triangle the region of its piece (see components());
+        pieces whose region is -1 (holes, outside) become exterior."""
+        cdef Tri* T = &self.T
+        cdef int t, r
+        for t in range(min(T.nt, comp.shape[0])):
+            if comp[t] < 0 or T.tstate[t] != T_UNMESHED:
+                continue
+            r = region_of_comp[comp[t]]
+            if r < 0:
+                T.tstate[t] = T_EXTERIOR
+            else:
+                T.tregion[t] = r
+
+    def state_at(self, double x, double y):
+        """State of the triangle holding (x, y): 1 exterior, 2 unmeshed, 3 meshed (a
+        point on an edge reports the triangle on its left); 1 outside the hull."""
+        cdef double p[2]
+        cdef int where = NONE, loc
+        p[0] = x
+        p[1] = y
+        loc = locate(&self.T, p, NONE, &where)
+        _raise_for(&self.T, loc)
+        if loc == LOC_IN_TRIANGLE:
+            return self.T.tstate[where]
+        if loc == LOC_ON_EDGE:
+            return self.T.tstate[where // 3]
+        if loc == LOC_ON_VERTEX:
+            return self.T.tstate[self.T.vhe[where] // 3]
+        return T_EXTERIOR
+
+    def state_counts(self):
+        """Number of triangles in each state: (exterior incl. ghosts, unmeshed, meshed)."""
+        cdef int t, ext = 0, unm = 0, msh = 0
+        for t in range(self.T.nt):
+            if self.T.tstate[t] == T_EXTERIOR:
+                ext += 1
+            elif self.T.tstate[t] == T_UNMESHED:
+                unm += 1
+            elif self.T.tstate[t] == T_MESHED:
+                msh += 1
+        return ext, unm, msh
+
+    def validate(self):
+        """Check the half-edge structure itself (twins, flags, orientation, vertex
+        half-edges).  Returns a list of problems (empty when all is well)."""
+        problems = []
+        cdef Tri* T = &self.T
+        cdef int t, k, e, f, v
+        for t in range(T.nt):
+            if T.tstate[t] == T_FREE:
+                continue
+            for k in range(3):
+                e = 3 * t + k
+                f = T.twin[e]
+                if f < 0 or f >= 3 * T.nt:
+                    problems.append(f"half-edge {e}: twin {f} out of range")
+                    continue
+                if T.twin[f] != e:
+                    problems.append(f"half-edge {e}: twin of twin is {T.twin[f]}")
+                if T.tv[f] != T.tv[nxt(e)] or T.tv[nxt(f)] != T.tv[e]:
+                    problems.append(f"half-edge {e}: twin {f} has other end points")
+                if T.eflag[f] != T.eflag[e]:
+                    problems.append(f"half-edge {e}: flags differ from twin")
+            if not is_ghost(T, t):
+                if orient2d(P(T, T.tv[3 * t]), P(T, T.tv[3 * t + 1]), P(T, T.tv[3 * t + 2])) <= 0:
+                    problems.append(f"triangle {t}: not counter-clockwise")
+        for v in range(T.nv):
+            e = T.vhe[v]
+            if e >= 0 and (T.tstate[e // 3] == T_FREE or T.tv[e] != v):
+                problems.append(f"vertex {v}: stale half-edge {e}")
+        return problems
+
+    def arrays(self, bint include_exterior=False):
+        """The domain's triangles as compact numpy arrays.
+
+        Returns a dict: points (n, 2), triangles (t, 3) counter-clockwise, neighbors
+        (t, 3) with neighbors[i, k] across the edge opposite vertex k (-1: none),
+        segments (s, 2) (constrained edges of the domain, each once), regions (t,),
+        vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
+        cdef Tri* T = &self.T
+        cdef int t, k, e, ntri = 0, nvo = 0, u
+        keep_arr = np.zeros(T.nt, dtype=np.uint8)
+        cdef uint8_t[::1] keep = keep_arr
+        for t in range(T.nt):
+            if T.tstate[t] == T_UNMESHED or T.tstate[t] == T_MESHED or (
+                    include_exterior and T.tstate[t] == T_EXTERIOR and not is_ghost(T, t)):
+                keep[t] = 1
+                ntri += 1
+        tri_index_arr = np.full(T.nt, -1, dtype=np.int32)
+        cdef int32_t[::1] tri_index = tri_index_arr
+        vmap_arr = np.full(T.nv, -1, dtype=np.int32)
+        cdef int32_t[::1] vmap = vmap_arr
+        tris_arr = np.empty((ntri, 3), dtype=np.int32)
+        cdef int32_t[:, ::1] tris = tris_arr
+        regions_arr = np.empty(ntri, dtype=np.int32)
+        cdef int32_t[::1] regions = regions_arr
+        ntri = 0
+        for t in range(T.nt):
+            if keep[t]:
+                tri_index[t] = ntri
+                regions[ntri] = T.tregion[t]
+                for k in range(3):
+                    u = T.tv[3 * t + k]
+                    if vmap[u] < 0:
+                        vmap[u] = nvo
+                        nvo += 1
+                    tris[ntri, k] = vmap[u]
+                ntri += 1
+        points_arr = np.empty((nvo, 2), dtype=np.float64)
+        cdef double[:, ::1] pts = points_arr
+        for u in range(T.nv):
+            if vmap[u] >= 0:
+                pts[vmap[u], 0] = T.xy[2 * u]
+                pts[vmap[u], 1] = T.xy[2 * u + 1]
+        nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
+        cdef int32_t[:, ::1] nbr = nbr_arr
+        segs = []
+        for t in range(T.nt):
+            if keep[t]:
+                for k in range(3):
+                    e = 3 * t + k
+                    # the edge opposite vertex k is half-edge 3t + (k+1) % 3
+                    u = T.twin[3 * t + (k + 1) % 3] // 3
+                    if keep[u]:
+                        nbr[tri_index[t], k] = tri_index[u]
+                    if T.eflag[e] & E_SEGMENT:
+                        u = T.twin[e] // 3
+                        if not keep[u] or u > t:
+                            segs.append((vmap[T.tv[e]], vmap[T.tv[nxt(e)]]))
+        seg_arr = np.array(segs, dtype=np.int32).reshape(-1, 2)
+        return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
+                    segments=seg_arr, regions=regions_arr, vertex_map=vmap_arr)
+
+    def raw(self):
+        """Copies of the raw kernel arrays (for tests and debugging)."""
+        cdef Tri* T = &self.T
+        n3 = 3 * T.nt
+        return dict(
+            xy=np.asarray(<double[:2 * T.nv]> T.xy).reshape(-1, 2).copy(),
+            tv=np.asarray(<int32_t[:n3]> T.tv).copy(),
+            twin=np.asarray(<int32_t[:n3]> T.twin).copy(),
+            eflag=np.asarray(<uint8_t[:n3]> T.eflag).copy(),
+            tstate=np.asarray(<uint8_t[:T.nt]> T.tstate).copy(),
+            tregion=np.asarray(<int32_t[:T.nt]> T.tregion).copy(),
+            vhe=np.asarray(<int32_t[:T.nv]> T.vhe).copy())
+
+
+    # ------------------------------------------------------------ Basic_aft
+
+    def set_size_grid(self, double x0, double y0, double dx, double dy,
+                      const double[:, ::1] h):
+        """The size field: h[j, i] at (x0 + i dx, y0 + j dy), bilinear in between; a
+        1 x 1 array is a constant.  Values must be finite and positive (checked by the
+        Python layer)."""
+        cdef int ny = h.shape[0], nx = h.shape[1], i, j
+        cdef double* buf = <double*> malloc(nx * ny * sizeof(double))
+        if buf == NULL:
+            raise MemoryError()
+        for j in range(ny):
+            for i in range(nx):
+                buf[j * nx + i] = h[j, i]
+        free(self.A.size.h)
+        self.A.size.h = buf
+        self.A.size.nx = nx
+        self.A.size.ny = ny
+        self.A.size.x0 = x0
+        self.A.size.y0 = y0
+        self.A.size.dx = dx if dx > 0 else 1.0
+        self.A.size.dy = dy if dy > 0 else 1.0
+
+    def size_at(self, double x, double y):
+        return size_at(&self.A.size, x, y)
+
+    def set_options(self, *, int order=ORDER_SHORTEST, long long max_triangles=-1,
+                    double min_area=0.0, double close_factor=0.5, bint swaps=True,
+                    bint greedy=False):
+        self.A.order = order
+        self.A.max_triangles = max_triangles
+        self.A.min_area = min_area
+        self.A.close_factor = close_factor
+        self.A.swaps = swaps
+        self.A.greedy = greedy
+
+    def convert_to_frontal_edge_set(self):
+        _raise_for(&self.T, convert_to_frontal_edge_set(&self.A, &self.T))
+
+    def get_next_edge(self):
+        """The built-in Get_next_edge (heap order); -1 when the front is empty."""
+        return get_next_edge(&self.A, &self.T)
+
+    def front_edges(self):
+        """All current front half-edges (int32 array)."""
+        cdef int t, k
+        out = []
+        for t in range(self.T.nt):
+            if self.T.tstate[t] == T_UNMESHED:
+                for k in range(3):
+                    if blocking(&self.T, 3 * t + k):
+                        out.append(3 * t + k)
+        return np.array(out, dtype=np.int32)
+
+    def push_front_edge(self, int e):
+        """Queue a front edge in the heap (for Python Get_next_edge strategies that
+        manage their own order this is not needed)."""
+        self._check_edge(e)
+        _raise_for(&self.T, heap_push(&self.A, &self.T, e))
+
+    def edge(self, int e):
+        """(origin, destination) vertex indices of half-edge e."""
+        self._check_edge(e)
+        return self.T.tv[e], self.T.tv[nxt(e)]
+
+    def is_front(self, int e):
+        self._check_edge(e)
+        return bool(is_front(&self.T, e))
+
+    def vertex(self, int v):
+        if not 0 <= v < self.T.nv:
+            raise IndexError(v)
+        return self.T.xy[2 * v], self.T.xy[2 * v + 1]
+
+    def compute_new_candidate(self, int e):
+        """The built-in Compute_new_candidate: (x, y, h) of R and the local size."""
+        cdef double R[2]
+        cdef double h
+        self._check_front(e)
+        compute_new_candidate(&self.A, &self.T, e, R, &h)
+        return R[0], R[1], h
+
+    def compute_existing_candidate(self, int e):
+        self._check_front(e)
+        return compute_existing_candidate(&self.T, e)
+
+    def new_is_preferred(self, int e, double rx, double ry, int S, double h):
+        cdef double R[2]
+        R[0] = rx
+        R[1] = ry
+        self._check_front(e)
+        return bool(new_is_preferred(&self.A, &self.T, e, R, S, h))
+
+    def mesh_size_constraint(self, int e, double rx, double ry):
+        cdef double R[2]
+        R[0] = rx
+        R[1] = ry
+        self._check_front(e)
+        return bool(mesh_size_constraint(&self.A, &self.T, e, R))
+
+    def check_visible(self, int e, double rx, double ry):
+        """Figure 8.  Returns (visible, left, right): the crossed edges as (origin,
+        destination) pairs."""
+        cdef double R[2]
+        R[0] = rx
+        R[1] = ry
+        self._check_front(e)
+        res = check_visible(&self.A, &self.T, e, R)
+        _raise_for(&self.T, res)
+        left = [(self.T.tv[x], self.T.tv[nxt(x)]) for x in self.A.left[:self.A.nleft]]
+        right = [(self.T.tv[x], self.T.tv[nxt(x)]) for x in self.A.right[:self.A.nright]]
+        self.vis_edge = e if res == 1 else NONE
+        self.vis_R[0] = rx
+        self.vis_R[1] = ry
+        return res == 1, left, right
+
+    def is_crowded(self, int e, double rx, double ry, double h):
+        """New_is_preferred's proximity rule, for the R that check_visible(e, rx, ry)
+        just found visible."""
+        cdef double R[2]
+        R[0] = rx
+        R[1] = ry
+        if self.vis_edge != e or self.vis_R[0] != rx or self.vis_R[1] != ry:
+            raise ValueError("is_crowded needs a check_visible of the same edge and R "
+                             "that answered visible, just before")
+        res = is_crowded(&self.A, &self.T, R, h)
+        _raise_for(&self.T, res)
+        return res == 1
+
+    def update_internal(self, int e, double rx, double ry):
+        """Insert R and the edges F, G; returns T(E, R) for add_triangle.  Must follow a
+        check_visible(e, rx, ry) that answered visible."""
+        cdef double R[2]
+        R[0] = rx
+        R[1] = ry
+        self._check_front(e)
+        if self.vis_edge != e or self.vis_R[0] != rx or self.vis_R[1] != ry:
+            raise ValueError("update_internal needs a check_visible of the same edge and R "
+                             "that answered visible, just before")
+        self.vis_edge = NONE
+        t = update_internal(&self.A, &self.T, e, R)
+        _raise_for(&self.T, t)
+        return t
+
+    def update_boundary(self, int e):
+        self._check_front(e)
+        self.vis_edge = NONE
+        return update_boundary(&self.A, &self.T, e)
+
+    def add_triangle(self, int t):
+        if not 0 <= t < self.T.nt or self.T.tstate[t] != T_UNMESHED:
+            raise ValueError(f"triangle {t} is not an unmeshed triangle")
+        self.A.n_steps += 1
+        _raise_for(&self.T, add_triangle(&self.A, &self.T, t))
+
+    def run(self):
+        """The compiled Basic_aft loop with the built-in subtasks (GIL released)."""
+        cdef int res
+        with nogil:
+            res = basic_aft_loop(&self.A, &self.T)
+        _raise_for(&self.T, res)
+        if DEBUG:
+            problems = self.validate()
+            if problems:
+                raise KernelError("after Basic_aft: " + "; ".join(problems[:5]))
+
+    def counters(self):
+        return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,
+                    new_vertices=self.A.n_new, steps=self.A.n_steps)
+
+    def _check_edge(self, int e):
+        if not 0 <= e < 3 * self.T.nt or self.T.tstate[e // 3] == T_FREE:
+            raise ValueError(f"{e} is not a half-edge of the triangulation")
+
+    def _check_front(self, int e):
+        self._check_edge(e)
+        if not is_front(&self.T, e):
+            raise ValueError(f"half-edge {e} is not a front edge")
+
+
+def hilbert_keys(const double[:, ::1] xy, int bits=16):
+    """Index of each point along a Hilbert curve of 2**bits cells a side laid over the
+    points' bounding square (int64)."""
+    cdef Py_ssize_t n = xy.shape[0], i
+    out_arr = np.zeros(n, dtype=np.int64)
+    cdef int64_t[::1] out = out_arr
+    if n == 0:
+        return out_arr
+    cdef double lox = xy[0, 0], loy = xy[0, 1], hix = xy[0, 0], hiy = xy[0, 1], span, scale
+    cdef int64_t side = (<int64_t> 1 << bits) - 1, x, y, s, d, rx, ry, tmp
+    with nogil:
+        for i in range(n):
+            lox = min(lox, xy[i, 0]); hix = max(hix, xy[i, 0])
+            loy = min(loy, xy[i, 1]); hiy = max(hiy, xy[i, 1])
+        span = max(hix - lox, hiy - loy)
+        if span > 0:
+            scale = side / span
+            for i in range(n):
+                x = <int64_t> ((xy[i, 0] - lox) * scale)
+                y = <int64_t> ((xy[i, 1] - loy) * scale)
+                x = min(max(x, 0), side)
+                y = min(max(y, 0), side)
+                d = 0
+                s = <int64_t> 1 << (bits - 1)
+                while s > 0:
+                    rx = 1 if (x & s) else 0
+                    ry = 1 if (y & s) else 0
+                    d += s * s * ((3 * rx) ^ ry)
+                    # rotate the quadrant so the curve inside has the standard orientation
+                    if ry == 0:
+                        if rx == 1:
+                            x = side - x
+                            y = side - y
+                        tmp = x
+                        x = y
+                        y = tmp
+                    s >>= 1
+                out[i] = d
+    return out_arr
+
+
+
+def orient2d_many(const double[:, ::1] points, const int32_t[:, ::1] tri):
+    """Exact orientation sign of each row (a, b, c) of `tri` (int8 array)."""
+    cdef Py_ssize_t n = tri.shape[0], i
+    out_arr = np.empty(n, dtype=np.int8)
+    cdef int8_t[::1] out = out_arr
+    with nogil:
+        for i in range(n):
+            out[i] = orient2d(&points[tri[i, 0], 0], &points[tri[i, 1], 0], &points[tri[i, 2], 0])
+    return out_arr
+
+
+def incircle_many(const double[:, ::1] points, const int32_t[:, ::1] quad):
+    """Exact incircle sign of each row (a, b, c, d) of `quad` (int8 array)."""
+    cdef Py_ssize_t n = quad.shape[0], i
+    out_arr = np.empty(n, dtype=np.int8)
+    cdef int8_t[::1] out = out_arr
+    with nogil:
+        for i in range(n):
+            out[i] = incircle(&points[quad[i, 0], 0], &points[quad[i, 1], 0],
+                              &points[quad[i, 2], 0], &points[quad[i, 3], 0])
+    return out_arr

@@ -1,0 +1,549 @@
+# Basic_aft (Figure 5 of the paper) on the constrained Delaunay triangulation (§3).
+#
+# One triangulation covers the whole domain.  Each triangle is T_UNMESHED or T_MESHED;
+# the frontal edge set C is implicit: a half-edge is a front edge exactly when it is
+# constrained (blocking(): an input segment, or the boundary between the two states)
+# and its own triangle is unmeshed.  So the unmeshed triangles are cd(S(E)) for every
+# component at once, and
+#   * Compute_existing_candidate is the apex of the unmeshed triangle on E;
+#   * Update_boundary's "if -F in C delete -F else insert F" (Figure 6, all four cases:
+#     toggles, the closing three-edge case, a split component, a merged hole) happens by
+#     itself when T(E, S) changes state: an edge of it that was a front edge stops being
+#     one, an unconstrained one becomes a front edge seen from the other side;
+#   * Update_internal inserts R into cd(S(E)) and makes sure F and G are edges.
+# The heap only orders the work (Get_next_edge); it is not the definition of C, so
+# stale entries are simply skipped (lazy deletion).
+
+from libc.math cimport sqrt
+
+cdef extern from "Python.h":
+    # declared here without Cython's "except -1" so that the compiled loop can turn a
+    # pending Ctrl-C into a status code instead of an exception inside a nogil routine
+    int PyErr_CheckSignals()
+    void PyErr_Clear()
+
+cdef enum:
+    ORDER_SHORTEST = 0
+    ORDER_LONGEST = 1
+    ORDER_OLDEST = 2
+
+cdef struct HeapItem:
+    double key
+    int64_t seq         # insertion count: ties and oldest-first
+    int32_t he          # the half-edge when pushed (it may move; org/dst identify it)
+    int32_t org
+    int32_t dst
+
+cdef struct Aft:
+    HeapItem* heap
+    int heap_n, heap_cap
+    int64_t seq
+    int order
+    SizeField size
+    int64_t max_triangles   # N_max of formula (4); < 0: none
+    double min_area         # A_min of formula (5); <= 0: none
+    double close_factor     # New_is_preferred takes S when |S - R| < close_factor * h
+    bint swaps              # Add_triangle keeps the meshed region a CDT by edge swaps
+    bint greedy             # New_is_preferred is always false
+    int64_t n_meshed        # N(T)
+    int64_t n_unmeshed      # triangles of the unmeshed CDT
+    int64_t n_new           # vertices created by Update_internal
+    int64_t n_steps         # passes through the while loop
+    # Check_visible's output: crossed edges of the line of sight, and where R lies
+    int32_t* left
+    int32_t* right
+    int nleft, nright, lr_cap
+    int vis_loc, vis_where
+
+
+cdef int aft_init(Aft* A) noexcept nogil:
+    memset(A, 0, sizeof(Aft))
+    A.heap_cap = 1024
+    A.heap = <HeapItem*> malloc(A.heap_cap * sizeof(HeapItem))
+    A.lr_cap = 64
+    A.left = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
+    A.right = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
+    A.size.nx = 1
+    A.size.ny = 1
+    A.size.h = <double*> malloc(sizeof(double))
+    A.max_triangles = -1
+    A.close_factor = 0.5
+    A.swaps = True
+    if A.heap == NULL or A.left == NULL or A.right == NULL or A.size.h == NULL:
+        return ERR_NOMEM
+    A.size.h[0] = 1.0
+    return 0
+
+
+cdef void aft_free(Aft* A) noexcept nogil:
+    free(A.heap); free(A.left); free(A.right); free(A.size.h)
+    memset(A, 0, sizeof(Aft))
+
+
+# ---------------------------------------------------------------- the heap
+
+cdef inline bint _before(const HeapItem* x, const HeapItem* y) noexcept nogil:
+    if x.key != y.key:
+        return x.key < y.key
+    return x.seq < y.seq
+
+
+cdef int heap_push(Aft* A, Tri* T, int e) noexcept nogil:
+    cdef HeapItem item
+    cdef double dx, dy
+    cdef int i, parent
+    cdef HeapItem* q
+    if A.heap_n == A.heap_cap:
+        if _grow(<void**> &A.heap, 2 * A.heap_cap * sizeof(HeapItem)):
+            return ERR_NOMEM
+        A.heap_cap *= 2
+    item.org = T.tv[e]
+    item.dst = T.tv[nxt(e)]
+    item.he = e
+    item.seq = A.seq
+    A.seq += 1
+    dx = T.xy[2 * item.dst] - T.xy[2 * item.org]
+    dy = T.xy[2 * item.dst + 1] - T.xy[2 * item.org + 1]
+    if A.order == ORDER_SHORTEST:
+        item.key = dx * dx + dy * dy
+    elif A.order == ORDER_LONGEST:
+        item.key = -(dx * dx + dy * dy)
+    else:
+        item.key = 0.0
+    q = A.heap
+    i = A.heap_n
+    A.heap_n += 1
+    while i > 0:
+        parent = (i - 1) >> 1
+        if not _before(&item, &q[parent]):
+            break
+        q[i] = q[parent]
+        i = parent
+    q[i] = item
+    return 0
+
+
+cdef void heap_pop(Aft* A, HeapItem* out) noexcept nogil:
+    cdef HeapItem* q = A.heap
+    cdef HeapItem last
+    cdef int i = 0, child
+    out[0] = q[0]
+    A.heap_n -= 1
+    if A.heap_n == 0:
+        return
+    last = q[A.heap_n]
+    while True:
+        child = 2 * i + 1
+        if child >= A.heap_n:
+            break
+        if child + 1 < A.heap_n and _before(&q[child + 1], &q[child]):
+            child += 1
+        if not _before(&q[child], &last):
+            break
+        q[i] = q[child]
+        i = child
+    q[i] = last
+
+
+cdef inline bint is_front(Tri* T, int e) noexcept nogil:
+    return T.tstate[e // 3] == T_UNMESHED and blocking(T, e)
+
+
+# ---------------------------------------------------------------- the subtasks
+
+cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
+    """C = every constrained half-edge of an unmeshed triangle (the domain's CDT has
+    been built and carved).  Also counts the triangles for formula (4)."""
+    cdef int t, k
+    A.heap_n = 0
+    A.n_meshed = 0
+    A.n_unmeshed = 0
+    for t in range(T.nt):
+        if T.tstate[t] == T_MESHED:
+            A.n_meshed += 1
+        elif T.tstate[t] == T_UNMESHED:
+            A.n_unmeshed += 1
+            for k in range(3):
+                if blocking(T, 3 * t + k):
+                    if heap_push(A, T, 3 * t + k):
+                        return ERR_NOMEM
+    return 0
+
+
+cdef int get_next_edge(Aft* A, Tri* T) noexcept nogil:
+    """Pop the heap until an entry is still a front edge; NONE when C is empty.
+    Half-edges move between slots when triangles are rewritten, so an entry is
+    identified by its end points and found again around its origin if needed."""
+    cdef HeapItem item
+    cdef int e
+    while A.heap_n > 0:
+        heap_pop(A, &item)
+        e = item.he
+        if not (e < 3 * T.nt and T.tstate[e // 3] != T_FREE
+                and T.tv[e] == item.org and T.tv[nxt(e)] == item.dst):
+            e = find_edge(T, item.org, item.dst)
+            if e < 0:
+                continue
+        if is_front(T, e):
+            return e
+    return NONE
+
+
+cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
+    return T.tv[prv(e)]
+
+
+cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
+    """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
+    distance from a and b that the local size asks for (an equilateral triangle when
+    |E| equals the size), kept between 0.55 |E| and 2 |E| so that the triangle's shape
+    stays reasonable where the size changes faster than the front."""
+    cdef double* pa = P(T, T.tv[e])
+    cdef double* pb = P(T, T.tv[nxt(e)])
+    cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
+    cdef double ex = pb[0] - pa[0], ey = pb[1] - pa[1]
+    cdef double L = sqrt(ex * ex + ey * ey)
+    cdef double h = size_at(&A.size, mx, my)
+    cdef double d, height, nx, ny
+    nx = -ey / L
+    ny = ex / L
+    # one correction with the size at the first guess, for graded sizes
+    d = _side_length(h, L)
+    height = sqrt(d * d - 0.25 * L * L)
+    h = 0.5 * (h + size_at(&A.size, mx + nx * height, my + ny * height))
+    d = _side_length(h, L)
+    height = sqrt(d * d - 0.25 * L * L)
+    R[0] = mx + nx * height
+    R[1] = my + ny * height
+    h_out[0] = h
+
+
+cdef inline double _side_length(double h, double L) noexcept nogil:
+    if h < 0.55 * L:
+        return 0.55 * L
+    if h > 2.0 * L:
+        return 2.0 * L
+    return h
+
+
+cdef bint new_is_preferred(Aft* A, Tri* T, int e, const double* R, int S, double h) noexcept nogil:
+    """Prefer R only if T(E, R) will be a CDT triangle once R is inserted (Lemma 3.1:
+    S strictly outside the circumcircle of T(E, R)), and S is not already about where R
+    would go.  Never true when R and S coincide (then |S - R| = 0)."""
+    cdef double* pa
+    cdef double* pb
+    cdef double* ps
+    cdef double dx, dy
+    if A.greedy:
+        return False
+    pa = P(T, T.tv[e])
+    pb = P(T, T.tv[nxt(e)])
+    ps = P(T, S)
+    if orient2d(pa, pb, R) <= 0:
+        return False
+    if incircle(pa, pb, R, ps) >= 0:
+        return False
+    dx = ps[0] - R[0]
+    dy = ps[1] - R[1]
+    if dx * dx + dy * dy < (A.close_factor * h) * (A.close_factor * h):
+        return False
+    return True
+
+
+cdef bint mesh_size_constraint(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
+    """Formula (4): refuse a new vertex when the mesh could then exceed N_max, and
+    formula (5): refuse it when T(E, R) would be smaller than A_min.
+
+    For (4): by the appendix's formula (6) the unmeshed CDT, whose vertices all lie on
+    C, has exactly N(C) + 2(m - k) triangles (m holes, k components), so
+    N(T) + #unmeshed is the final count if no vertex is added from now on, and each
+    new vertex adds exactly two.  This is formula (4) with the exact m and k instead of
+    the bound 2(m - 1)."""
+    cdef double* pa
+    cdef double* pb
+    cdef double area
+    if A.max_triangles >= 0 and A.n_meshed + A.n_unmeshed + 2 > A.max_triangles:
+        return True
+    if A.min_area > 0.0:
+        pa = P(T, T.tv[e])
+        pb = P(T, T.tv[nxt(e)])
+        area = 0.5 * ((pb[0] - pa[0]) * (R[1] - pa[1]) - (pb[1] - pa[1]) * (R[0] - pa[0]))
+        if area < A.min_area:
+            return True
+    return False
+
+
+cdef int _push_lr(Aft* A, bint to_left, int e) noexcept nogil:
+    if A.nleft >= A.lr_cap or A.nright >= A.lr_cap:
+        if (_grow(<void**> &A.left, 2 * A.lr_cap * sizeof(int32_t))
+                or _grow(<void**> &A.right, 2 * A.lr_cap * sizeof(int32_t))):
+            return ERR_NOMEM
+        A.lr_cap *= 2
+    if to_left:
+        A.left[A.nleft] = e
+        A.nleft += 1
+    else:
+        A.right[A.nright] = e
+        A.nright += 1
+    return 0
+
+
+cdef int check_visible(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
+    """Figure 8: walk from the midpoint M of E toward R through the unmeshed CDT.
+
+    Returns 1 (visible; A.vis_loc / A.vis_where say where R lies, ready for insertion)
+    or 0 (not visible), or an error.  The crossed edges go to A.left / A.right as in the
+    paper (an edge pivoting on the left end of the previous one goes to Right).  The
+    walk stops as not visible when it meets a constrained edge, when R is at a vertex or
+    on a constrained edge, or when the line of sight passes exactly through a vertex.
+    It only moves forward along the segment M R, so it cannot loop; the step cap is a
+    guard against a broken structure.
+
+    Visibility from the midpoint suffices only when no node visible from E lies in the
+    circumcircle of T(E, R) (the paper's argument), i.e. when S is outside it, Lemma
+    3.1's condition: without it the answer is 'not visible'."""
+    cdef double* pa = P(T, T.tv[e])
+    cdef double* pb = P(T, T.tv[nxt(e)])
+    cdef double M[2]
+    cdef int g = e, t, u, v, w, o1, o2, ow, steps = 0, exit_e
+    A.nleft = 0
+    A.nright = 0
+    A.vis_loc = -1
+    A.vis_where = NONE
+    if orient2d(pa, pb, R) <= 0:
+        return 0
+    if incircle(pa, pb, R, P(T, compute_existing_candidate(T, e))) >= 0:
+        return 0
+    M[0] = 0.5 * (pa[0] + pb[0])
+    M[1] = 0.5 * (pa[1] + pb[1])
+    while steps <= T.nt:
+        steps += 1
+        # triangle (u, v, w) entered through g = u->v: u left, v right of M->R
+        u = T.tv[g]
+        v = T.tv[nxt(g)]
+        w = T.tv[prv(g)]
+        if w == GHOST:
+            return ERR_INTERNAL
+        o1 = orient2d(P(T, v), P(T, w), R)
+        o2 = orient2d(P(T, w), P(T, u), R)
+        if o1 >= 0 and o2 >= 0:
+            if o1 == 0 and o2 == 0:
+                return 0                        # R coincides with w
+            if o1 == 0:
+                if blocking(T, nxt(g)):
+                    return 0
+                A.vis_loc = LOC_ON_EDGE
+                A.vis_where = nxt(g)
+                return 1
+            if o2 == 0:
+                if blocking(T, prv(g)):
+                    return 0
+                A.vis_loc = LOC_ON_EDGE
+                A.vis_where = prv(g)
+                return 1
+            A.vis_loc = LOC_IN_TRIANGLE
+            A.vis_where = g // 3
+            return 1
+        ow = orient2d(M, R, P(T, w))
+        if ow == 0:
+            return 0                            # the line of sight runs through w
+        if ow > 0:
+            exit_e = nxt(g)                     # v->w: w left, pivot on the right end
+            if _push_lr(A, True, exit_e):
+                return ERR_NOMEM
+        else:
+            exit_e = prv(g)                     # w->u: w right, pivot on the left end
+            if _push_lr(A, False, exit_e):
+                return ERR_NOMEM
+        if blocking(T, exit_e):
+            return 0
+        g = T.twin[exit_e]
+    return ERR_INTERNAL
+
+
+cdef inline double _dist2_point_segment(const double* p, const double* a,
+                                       const double* b) noexcept nogil:
+    cdef double ex = b[0] - a[0], ey = b[1] - a[1]
+    cdef double px = p[0] - a[0], py = p[1] - a[1]
+    cdef double L2 = ex * ex + ey * ey, s = 0.0
+    if L2 > 0.0:
+        s = (px * ex + py * ey) / L2
+        if s < 0.0:
+            s = 0.0
+        elif s > 1.0:
+            s = 1.0
+    px -= s * ex
+    py -= s * ey
+    return px * px + py * py
+
+
+cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
+    """The part of New_is_preferred that needs to know where R lies (so it runs right
+    after check_visible found it): R is refused when it would come closer than
+    close_factor * h to a vertex it would be joined to, or closer than half that to a
+    constrained edge it would face.  Those are exactly the vertices and constrained
+    edges of R's insertion cavity (the unmeshed triangles whose circumcircles contain R,
+    reached without crossing a constraint), because they become R's neighbours.
+    Returns 1 (crowded), 0, or an error."""
+    cdef int n = 0, i, k, e, t, u, j, x, y, z
+    cdef double dv2 = (A.close_factor * h) * (A.close_factor * h)
+    cdef double de2 = 0.25 * dv2
+    cdef double dx, dy
+    cdef bint seen
+    if reserve_stack(T, 64):
+        return ERR_NOMEM
+    if A.vis_loc == LOC_IN_TRIANGLE:
+        T.stack[0] = A.vis_where
+        n = 1
+    else:
+        T.stack[0] = A.vis_where // 3
+        T.stack[1] = T.twin[A.vis_where] // 3
+        n = 2
+    i = 0
+    while i < n:
+        t = T.stack[i]
+        i += 1
+        for k in range(3):
+            e = 3 * t + k
+            x = T.tv[e]
+            dx = T.xy[2 * x] - R[0]
+            dy = T.xy[2 * x + 1] - R[1]
+            if dx * dx + dy * dy < dv2:
+                return 1
+            if blocking(T, e):
+                if _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) < de2:
+                    return 1
+                continue
+            u = T.twin[e] // 3
+            seen = False
+            for j in range(n):
+                if T.stack[j] == u:
+                    seen = True
+                    break
+            if seen or n >= 64:
+                continue
+            x = T.tv[3 * u]
+            y = T.tv[3 * u + 1]
+            z = T.tv[3 * u + 2]
+            if incircle(P(T, x), P(T, y), P(T, z), R) > 0:
+                T.stack[n] = u
+                n += 1
+    return 0
+
+
+cdef int add_triangle(Aft* A, Tri* T, int t) noexcept nogil:
+    """Mark T(E, U) meshed; its edges towards unmeshed triangles become front edges
+    (unless they already were: input segments inside the domain).  Then, if swaps are
+    on, flip edges inside the meshed region until it is again the CDT of its vertices,
+    the input edges and C (Lawson's flips, as Cline & Renka describe)."""
+    cdef int k, e, f
+    T.tstate[t] = T_MESHED
+    A.n_meshed += 1
+    A.n_unmeshed -= 1
+    for k in range(3):
+        e = 3 * t + k
+        f = T.twin[e]
+        if T.tstate[f // 3] == T_UNMESHED and not (T.eflag[e] & E_SEGMENT):
+            if heap_push(A, T, f):
+                return ERR_NOMEM
+    if A.swaps:
+        if reserve_stack(T, 3):
+            return ERR_NOMEM
+        T.stack[0] = 3 * t
+        T.stack[1] = 3 * t + 1
+        T.stack[2] = 3 * t + 2
+        return legalize_meshed(T, 3)
+    return 0
+
+
+cdef int update_boundary(Aft* A, Tri* T, int e) noexcept nogil:
+    """Take T(E, S): the unmeshed triangle on E.  Its state change performs Figure 6's
+    edge toggles (see the top of this file); returns that triangle for Add_triangle."""
+    return e // 3
+
+
+cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
+    """Insert R (located by check_visible) into the unmeshed CDT, then make sure F and
+    G are edges.  Returns the triangle T(E, R) for Add_triangle.
+
+    By Lemma 3.1 T(E, R) is a triangle of cd(S(E) + R) when S is outside C(E, R), which
+    check_visible has required, so after the Lawson insertion it is normally already
+    there; otherwise F and G are inserted as constraints by Cline & Renka's
+    retriangulation of exactly the triangles they cross."""
+    cdef int a = T.tv[e], b = T.tv[nxt(e)], v, res, f
+    v = add_vertex(T, R[0], R[1])
+    if v < 0:
+        return v
+    res = insert_vertex_at(T, v, A.vis_loc, A.vis_where)
+    if res < 0:
+        return res
+    A.n_unmeshed += 2
+    A.n_new += 1
+    f = find_edge(T, a, b)
+    if f < 0:
+        return ERR_INTERNAL
+    if T.tv[prv(f)] != v:
+        res = insert_segment(T, a, v, E_FIXED)
+        if res < 0:
+            return res
+        res = insert_segment(T, v, b, E_FIXED)
+        if res < 0:
+            return res
+        f = find_edge(T, a, b)
+        if f < 0 or T.tv[prv(f)] != v:
+            return ERR_INTERNAL
+        # the triangle becomes meshed next, so F and G stay constrained as front edges
+        T.eflag[nxt(f)] &= ~E_FIXED
+        T.eflag[T.twin[nxt(f)]] &= ~E_FIXED
+        T.eflag[prv(f)] &= ~E_FIXED
+        T.eflag[T.twin[prv(f)]] &= ~E_FIXED
+    return f // 3
+
+
+cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
+    """One pass through Figure 5's while loop for the current edge e."""
+    cdef double R[2]
+    cdef double h
+    cdef int S, t, vis
+    cdef bint new
+    compute_new_candidate(A, T, e, R, &h)
+    S = compute_existing_candidate(T, e)
+    new = new_is_preferred(A, T, e, R, S, h) and not mesh_size_constraint(A, T, e, R)
+    if new:
+        vis = check_visible(A, T, e, R)
+        if vis == 1:
+            vis = 1 - is_crowded(A, T, R, h)
+        if vis < 0:
+            return vis
+        new = vis == 1
+    if new:
+        t = update_internal(A, T, e, R)
+    else:
+        t = update_boundary(A, T, e)
+    if t < 0:
+        return t
+    A.n_steps += 1
+    return add_triangle(A, T, t)
+
+
+cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
+    """Figure 5, compiled: runs without the GIL and takes it back only every few
+    thousand steps to let Ctrl-C through."""
+    cdef int e, res
+    cdef int64_t count = 0
+    while True:
+        e = get_next_edge(A, T)
+        if e == NONE:
+            break
+        res = basic_aft_step(A, T, e)
+        if res < 0:
+            return res
+        count += 1
+        if count % 8192 == 0:
+            with gil:
+                if PyErr_CheckSignals() != 0:
+                    PyErr_Clear()
+                    return ERR_INTERRUPTED
+    if A.n_unmeshed != 0:
+        return ERR_INTERNAL
+    return 0

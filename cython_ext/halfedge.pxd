@@ -1,0 +1,84 @@
+# The kernel's triangulation: flat arrays of half-edges.  This is the one place the
+# convention is drawn; every function in cython_ext/ relies on it.
+#
+#                  v2 = tv[3t+2]
+#                   /\
+#                  /  \
+#    e2 = 3t+2    /    \    e1 = 3t+1
+#   (v2 -> v0)   /   t  \  (v1 -> v2)
+#               /        \
+#              /__________\
+#   v0 = tv[3t]  e0 = 3t    v1 = tv[3t+1]
+#               (v0 -> v1)
+#
+# * Triangle t owns the half-edges 3t, 3t+1, 3t+2; its vertices are listed
+#   counter-clockwise, and half-edge e runs from tv[e] to tv[nxt(e)] with t on its left.
+# * twin[e] is the same edge seen from the neighbouring triangle.  Inside the kernel it
+#   is never NONE: the outside of the convex hull is closed by "ghost" triangles whose
+#   third vertex is GHOST (a symbolic point at infinity), so every walk and every
+#   rotation around a vertex stays inside the arrays.  The public API sees -1 there.
+# * eflag[e] holds E_SEGMENT / E_FIXED and is always written on both twins together.
+# * vhe[v] is one half-edge leaving v (tv[vhe[v]] == v).
+# * tstate[t] says whether a triangle is outside the domain, still unmeshed, or meshed;
+#   the frontal edge set C of the paper is implicit: a half-edge is a front edge exactly
+#   when it is constrained (see blocking()) and its own triangle is unmeshed.
+from libc.stdint cimport int8_t, int32_t, uint8_t, uint32_t, int64_t
+
+cdef enum:
+    GHOST = -1          # the vertex at infinity of ghost triangles
+    NONE = -1           # no half-edge / no triangle
+
+    # eflag bits
+    E_SEGMENT = 1       # an input edge (boundary, interface, crack): never flipped
+    E_FIXED = 2         # a temporary constraint (F, G while Update_internal inserts them)
+
+    # tstate values
+    T_FREE = 0          # slot on the free list
+    T_EXTERIOR = 1      # ghost triangles, outside the domain, holes
+    T_UNMESHED = 2      # part of the unmeshed region S(E) of the paper
+    T_MESHED = 3        # part of the mesh T built so far
+
+    # status codes returned by kernel routines (0 = success)
+    ERR_NOMEM = -1
+    ERR_CROSSING = -2   # a new edge would cross a constrained edge (T.err_* say which)
+    ERR_COLLINEAR = -3  # all points on one line: no triangle exists
+    ERR_INTERNAL = -4   # an invariant broke: a bug, reported instead of looping or crashing
+    ERR_INTERRUPTED = -5
+
+    # results of locate()
+    LOC_IN_TRIANGLE = 0
+    LOC_ON_EDGE = 1
+    LOC_ON_VERTEX = 2
+    LOC_OUTSIDE = 3     # strictly outside the convex hull: the answer is a ghost triangle
+
+cdef struct Tri:
+    double* xy          # 2 doubles per vertex
+    int32_t* vhe
+    int32_t nv, nv_cap
+    int32_t* tv         # 3 per triangle
+    int32_t* twin       # 3 per triangle
+    uint8_t* eflag      # 3 per triangle
+    uint8_t* tstate     # 1 per triangle
+    int32_t* tregion    # 1 per triangle
+    int32_t nt, nt_cap  # slots handed out so far / allocated
+    int32_t* free_tris  # reusable slots (tstate == T_FREE)
+    int32_t nfree
+    int32_t last        # a live finite triangle where the next walk starts
+    uint32_t rng        # xorshift state for the stochastic walk
+    # scratch stacks, grown on demand, never shrunk
+    int32_t* stack
+    int32_t stack_cap
+    int32_t* buf        # chains of the Cline-Renka retriangulation
+    int32_t buf_cap
+    # where the last ERR_CROSSING came from: new edge (err_a, err_b) hit edge (err_u, err_v)
+    int32_t err_a, err_b, err_u, err_v
+
+
+cdef inline int nxt(int e) noexcept nogil:
+    return e - 2 if e % 3 == 2 else e + 1
+
+cdef inline int prv(int e) noexcept nogil:
+    return e + 2 if e % 3 == 0 else e - 1
+
+cdef inline int tri_of(int e) noexcept nogil:
+    return e // 3

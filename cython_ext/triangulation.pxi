@@ -1,0 +1,518 @@
+# Half-edge triangulation: storage, flips, point location and point insertion.
+# Conventions: halfedge.pxd.  Geometry is only ever read through the predicates.
+
+from libc.stdlib cimport malloc, realloc, free
+from libc.string cimport memset
+
+
+# ---------------------------------------------------------------- storage
+
+cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
+    memset(T, 0, sizeof(Tri))
+    if nv_cap < 8:
+        nv_cap = 8
+    if nt_cap < 16:
+        nt_cap = 16
+    T.xy = <double*> malloc(2 * nv_cap * sizeof(double))
+    T.vhe = <int32_t*> malloc(nv_cap * sizeof(int32_t))
+    T.nv_cap = nv_cap
+    T.tv = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
+    T.twin = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
+    T.eflag = <uint8_t*> malloc(3 * nt_cap * sizeof(uint8_t))
+    T.tstate = <uint8_t*> malloc(nt_cap * sizeof(uint8_t))
+    T.tregion = <int32_t*> malloc(nt_cap * sizeof(int32_t))
+    T.free_tris = <int32_t*> malloc(nt_cap * sizeof(int32_t))
+    T.nt_cap = nt_cap
+    T.stack_cap = 256
+    T.stack = <int32_t*> malloc(T.stack_cap * sizeof(int32_t))
+    T.buf_cap = 256
+    T.buf = <int32_t*> malloc(T.buf_cap * sizeof(int32_t))
+    T.last = NONE
+    T.rng = 2463534242u
+    if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
+            or T.tstate == NULL or T.tregion == NULL or T.free_tris == NULL
+            or T.stack == NULL or T.buf == NULL):
+        return ERR_NOMEM
+    return 0
+
+
+cdef void tri_free(Tri* T) noexcept nogil:
+    free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag)
+    free(T.tstate); free(T.tregion); free(T.free_tris); free(T.stack); free(T.buf)
+    memset(T, 0, sizeof(Tri))
+
+
+cdef int _grow(void** p, size_t new_bytes) noexcept nogil:
+    cdef void* q = realloc(p[0], new_bytes)
+    if q == NULL:
+        return ERR_NOMEM
+    p[0] = q
+    return 0
+
+
+cdef int reserve_vertices(Tri* T, int n) noexcept nogil:
+    cdef int cap = T.nv_cap
+    if n <= cap:
+        return 0
+    while cap < n:
+        cap *= 2
+    if (_grow(<void**> &T.xy, 2 * cap * sizeof(double)) or
+            _grow(<void**> &T.vhe, cap * sizeof(int32_t))):
+        return ERR_NOMEM
+    T.nv_cap = cap
+    return 0
+
+
+cdef int reserve_triangles(Tri* T, int n) noexcept nogil:
+    cdef int cap = T.nt_cap
+    if n <= cap:
+        return 0
+    while cap < n:
+        cap *= 2
+    if (_grow(<void**> &T.tv, 3 * cap * sizeof(int32_t)) or
+            _grow(<void**> &T.twin, 3 * cap * sizeof(int32_t)) or
+            _grow(<void**> &T.eflag, 3 * cap * sizeof(uint8_t)) or
+            _grow(<void**> &T.tstate, cap * sizeof(uint8_t)) or
+            _grow(<void**> &T.tregion, cap * sizeof(int32_t)) or
+            _grow(<void**> &T.free_tris, cap * sizeof(int32_t))):
+        return ERR_NOMEM
+    T.nt_cap = cap
+    return 0
+
+
+cdef int reserve_stack(Tri* T, int n) noexcept nogil:
+    cdef int cap = T.stack_cap
+    if n <= cap:
+        return 0
+    while cap < n:
+        cap *= 2
+    if _grow(<void**> &T.stack, cap * sizeof(int32_t)):
+        return ERR_NOMEM
+    T.stack_cap = cap
+    return 0
+
+
+cdef int reserve_buf(Tri* T, int n) noexcept nogil:
+    cdef int cap = T.buf_cap
+    if n <= cap:
+        return 0
+    while cap < n:
+        cap *= 2
+    if _grow(<void**> &T.buf, cap * sizeof(int32_t)):
+        return ERR_NOMEM
+    T.buf_cap = cap
+    return 0
+
+
+cdef int add_vertex(Tri* T, double x, double y) noexcept nogil:
+    """Append a vertex (not yet connected); returns its index or ERR_NOMEM."""
+    if reserve_vertices(T, T.nv + 1):
+        return ERR_NOMEM
+    T.xy[2 * T.nv] = x
+    T.xy[2 * T.nv + 1] = y
+    T.vhe[T.nv] = NONE
+    T.nv += 1
+    return T.nv - 1
+
+
+cdef int new_triangle(Tri* T) noexcept nogil:
+    """A free triangle slot (reused if possible); returns its index or ERR_NOMEM."""
+    if T.nfree > 0:
+        T.nfree -= 1
+        return T.free_tris[T.nfree]
+    if reserve_triangles(T, T.nt + 1):
+        return ERR_NOMEM
+    T.nt += 1
+    return T.nt - 1
+
+
+cdef inline double* P(Tri* T, int v) noexcept nogil:
+    return &T.xy[2 * v]
+
+
+cdef inline bint is_ghost(Tri* T, int t) noexcept nogil:
+    return T.tv[3 * t] == GHOST or T.tv[3 * t + 1] == GHOST or T.tv[3 * t + 2] == GHOST
+
+
+cdef inline bint blocking(Tri* T, int e) noexcept nogil:
+    """A constrained edge: an input segment, a temporary constraint, or the boundary
+    between two triangles of different state (which makes every front edge constrained
+    for the walks, flips and retriangulations of the unmeshed CDT)."""
+    if T.eflag[e] & (E_SEGMENT | E_FIXED):
+        return True
+    return T.tstate[e // 3] != T.tstate[T.twin[e] // 3]
+
+
+cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
+                         int ta, int tb, int tc, uint8_t fa, uint8_t fb, uint8_t fc,
+                         uint8_t state, int32_t region) noexcept nogil:
+    """Write triangle t = (a, b, c) with outer twins ta, tb, tc (NONE: set later by the
+    triangle on the other side) and edge flags fa, fb, fc; links the twins back."""
+    cdef int e = 3 * t
+    T.tv[e] = a
+    T.tv[e + 1] = b
+    T.tv[e + 2] = c
+    T.twin[e] = ta
+    T.twin[e + 1] = tb
+    T.twin[e + 2] = tc
+    T.eflag[e] = fa
+    T.eflag[e + 1] = fb
+    T.eflag[e + 2] = fc
+    if ta >= 0:
+        T.twin[ta] = e
+        T.eflag[ta] = fa
+    if tb >= 0:
+        T.twin[tb] = e + 1
+        T.eflag[tb] = fb
+    if tc >= 0:
+        T.twin[tc] = e + 2
+        T.eflag[tc] = fc
+    if a >= 0:
+        T.vhe[a] = e
+    if b >= 0:
+        T.vhe[b] = e + 1
+    if c >= 0:
+        T.vhe[c] = e + 2
+    T.tstate[t] = state
+    T.tregion[t] = region
+
+
+cdef inline uint32_t rand_next(Tri* T) noexcept nogil:
+    cdef uint32_t x = T.rng
+    x ^= x << 13
+    x ^= x >> 17
+    x ^= x << 5
+    T.rng = x
+    return x
+
+
+# ---------------------------------------------------------------- flips
+
+cdef void flip(Tri* T, int e) noexcept nogil:
+    """Swap the diagonal of the quadrilateral around half-edge e.
+
+    Before: t0 = (a, b, c) with e = a->b, t1 = (b, a, d) with twin f = b->a.
+    After:  t0 = (c, a, d) and t1 = (d, b, c); the new diagonal is c-d (3*t0+2 / 3*t1+2).
+    The caller has checked that the quadrilateral a, d, b, c is strictly convex.
+    """
+    cdef int t0 = e // 3
+    cdef int f = T.twin[e]
+    cdef int t1 = f // 3
+    cdef int e1 = nxt(e), e2 = prv(e), f1 = nxt(f), f2 = prv(f)
+    cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
+    cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
+    cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
+    cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
+    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, s0, r0)
+    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, s1, r1)
+
+
+cdef inline int in_circle_ext(Tri* T, int a, int b, int c, int d) noexcept nogil:
+    """Is d strictly inside the circumcircle of triangle (a, b, c)?  Ghost triangles
+    count as the open half-plane beyond their finite edge, which is what makes Lawson
+    flips also maintain the convex hull; a ghost d is never inside."""
+    if d == GHOST:
+        return 0
+    if a == GHOST:
+        return orient2d(P(T, b), P(T, c), P(T, d)) > 0
+    if b == GHOST:
+        return orient2d(P(T, c), P(T, a), P(T, d)) > 0
+    if c == GHOST:
+        return orient2d(P(T, a), P(T, b), P(T, d)) > 0
+    return incircle(P(T, a), P(T, b), P(T, c), P(T, d)) > 0
+
+
+cdef int lawson_after_insert(Tri* T, int nstack) noexcept nogil:
+    """Restore the (constrained) Delaunay property around a new vertex p.
+
+    T.stack[0:nstack] holds half-edges opposite p (p is the apex of each); an edge is
+    flipped when it is not blocking and the far apex lies inside the circumcircle."""
+    cdef int e, f, t0, t1, a, b, p, d
+    while nstack > 0:
+        nstack -= 1
+        e = T.stack[nstack]
+        if blocking(T, e):
+            continue
+        f = T.twin[e]
+        a = T.tv[e]
+        b = T.tv[nxt(e)]
+        p = T.tv[prv(e)]
+        d = T.tv[prv(f)]
+        if in_circle_ext(T, a, b, p, d):
+            t0 = e // 3
+            t1 = f // 3
+            flip(T, e)
+            # after the flip, p = c is the apex of 3*t0+1 (a->d) and of 3*t1 (d->b)
+            if reserve_stack(T, nstack + 2):
+                return ERR_NOMEM
+            T.stack[nstack] = 3 * t0 + 1
+            T.stack[nstack + 1] = 3 * t1
+            nstack += 2
+    return 0
+
+
+cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
+    """Lawson flips inside the meshed region (Add_triangle): flip every unconstrained
+    edge between two meshed triangles whose far apex is inside the circumcircle, until
+    none is left.  T.stack[0:nstack] holds the edges that may have become illegal."""
+    cdef int e, f, t0, t1
+    while nstack > 0:
+        nstack -= 1
+        e = T.stack[nstack]
+        f = T.twin[e]
+        t0 = e // 3
+        t1 = f // 3
+        if T.tstate[t0] != T_MESHED or T.tstate[t1] != T_MESHED:
+            continue
+        if T.eflag[e] & (E_SEGMENT | E_FIXED):
+            continue
+        if incircle(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]),
+                    P(T, T.tv[prv(f)])) > 0:
+            flip(T, e)
+            if reserve_stack(T, nstack + 4):
+                return ERR_NOMEM
+            # the four outer edges of the new pair may now be illegal
+            T.stack[nstack] = 3 * t0
+            T.stack[nstack + 1] = 3 * t0 + 1
+            T.stack[nstack + 2] = 3 * t1
+            T.stack[nstack + 3] = 3 * t1 + 1
+            nstack += 4
+    return 0
+
+
+# ---------------------------------------------------------------- point location
+
+cdef int find_live_finite(Tri* T) noexcept nogil:
+    cdef int t
+    for t in range(T.nt):
+        if T.tstate[t] != T_FREE and not is_ghost(T, t):
+            return t
+    return NONE
+
+
+cdef int classify(Tri* T, int t, int* o3, int* where) noexcept nogil:
+    """p is in closed triangle t with orientations o3 against its three edges (none
+    negative): say whether it is inside, on an edge, or on a vertex."""
+    cdef int k, nzero = 0, zk = 0
+    for k in range(3):
+        if o3[k] == 0:
+            nzero += 1
+            zk = k
+    if nzero == 0:
+        where[0] = t
+        return LOC_IN_TRIANGLE
+    if nzero == 1:
+        where[0] = 3 * t + zk
+        return LOC_ON_EDGE
+    # two zero orientations: p is the vertex opposite the one non-zero edge
+    for k in range(3):
+        if o3[k] != 0:
+            where[0] = T.tv[3 * t + (k + 2) % 3]
+            return LOC_ON_VERTEX
+    return ERR_INTERNAL
+
+
+cdef int locate_scan(Tri* T, const double* p, int* where) noexcept nogil:
+    """The safe fallback of locate(): test every triangle exactly."""
+    cdef int t, k, e
+    cdef int o3[3]
+    for t in range(T.nt):
+        if T.tstate[t] == T_FREE or is_ghost(T, t):
+            continue
+        for k in range(3):
+            e = 3 * t + k
+            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p)
+            if o3[k] < 0:
+                break
+        else:
+            return classify(T, t, o3, where)
+    for t in range(T.nt):
+        if T.tstate[t] == T_FREE or not is_ghost(T, t):
+            continue
+        for k in range(3):
+            e = 3 * t + k
+            if T.tv[e] != GHOST and T.tv[nxt(e)] != GHOST:
+                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p) > 0:
+                    where[0] = t
+                    return LOC_OUTSIDE
+    return ERR_INTERNAL
+
+
+cdef int locate(Tri* T, const double* p, int start, int* where) noexcept nogil:
+    """Find where point p lies, walking from triangle `start` (or T.last).
+
+    Returns LOC_IN_TRIANGLE (where = triangle), LOC_ON_EDGE (where = half-edge),
+    LOC_ON_VERTEX (where = vertex) or LOC_OUTSIDE (where = ghost triangle whose finite
+    edge sees p strictly on its outer side).  The walk visits edges in a random order
+    (so it cannot cycle forever on a constrained triangulation) and is capped; past the
+    cap it falls back to an exact scan of all triangles."""
+    cdef int t = start if start >= 0 else T.last
+    cdef int steps = 0, cap = 64 + 4 * T.nt
+    cdef int k, i, e, r
+    cdef int o3[3]
+    if t < 0 or t >= T.nt or T.tstate[t] == T_FREE:
+        t = find_live_finite(T)
+        if t < 0:
+            return ERR_INTERNAL
+    if is_ghost(T, t):
+        # step into the finite triangle behind the ghost's finite edge
+        for k in range(3):
+            e = 3 * t + k
+            if T.tv[e] != GHOST and T.tv[nxt(e)] != GHOST:
+                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p) > 0:
+                    where[0] = t
+                    return LOC_OUTSIDE
+                t = T.twin[e] // 3
+                break
+    while steps < cap:
+        steps += 1
+        r = <int> (rand_next(T) % 3)
+        for i in range(3):
+            k = (r + i) % 3
+            e = 3 * t + k
+            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p)
+            if o3[k] < 0:
+                t = T.twin[e] // 3
+                if is_ghost(T, t):
+                    where[0] = t
+                    T.last = e // 3
+                    return LOC_OUTSIDE
+                break
+        else:
+            T.last = t
+            return classify(T, t, o3, where)
+    return locate_scan(T, p, where)
+
+
+# ---------------------------------------------------------------- point insertion
+
+cdef int split_triangle(Tri* T, int t, int v) noexcept nogil:
+    """Insert vertex v inside triangle t (a ghost triangle too: v beyond its finite
+    edge); pushes the three edges opposite v onto T.stack.  Returns the stack size."""
+    cdef int e = 3 * t
+    cdef int a = T.tv[e], b = T.tv[e + 1], c = T.tv[e + 2]
+    cdef int tw0 = T.twin[e], tw1 = T.twin[e + 1], tw2 = T.twin[e + 2]
+    cdef uint8_t f0 = T.eflag[e], f1 = T.eflag[e + 1], f2 = T.eflag[e + 2]
+    cdef uint8_t s = T.tstate[t]
+    cdef int32_t r = T.tregion[t]
+    cdef int t1 = new_triangle(T)
+    if t1 < 0:
+        return ERR_NOMEM
+    cdef int t2 = new_triangle(T)
+    if t2 < 0:
+        return ERR_NOMEM
+    set_tri(T, t, a, b, v, tw0, NONE, NONE, f0, 0, 0, s, r)
+    set_tri(T, t1, b, c, v, tw1, NONE, 3 * t + 1, f1, 0, 0, s, r)
+    set_tri(T, t2, c, a, v, tw2, 3 * t + 2, 3 * t1 + 1, f2, 0, 0, s, r)
+    if reserve_stack(T, 3):
+        return ERR_NOMEM
+    T.stack[0] = 3 * t
+    T.stack[1] = 3 * t1
+    T.stack[2] = 3 * t2
+    if not is_ghost(T, t):
+        T.last = t
+    return 3
+
+
+cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
+    """Insert vertex v on the interior of the edge of half-edge e (a->b, in t0 = (a,b,c);
+    twin in t1 = (b,a,d)); the two halves keep the edge's flags (a split segment stays
+    a segment).  Pushes the four edges opposite v; returns the stack size."""
+    cdef int f = T.twin[e]
+    cdef int t0 = e // 3, t1 = f // 3
+    cdef int e1 = nxt(e), e2 = prv(e), f1 = nxt(f), f2 = prv(f)
+    cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
+    cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
+    cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef uint8_t g = T.eflag[e]
+    cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
+    cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
+    cdef int t2 = new_triangle(T)
+    if t2 < 0:
+        return ERR_NOMEM
+    cdef int t3 = new_triangle(T)
+    if t3 < 0:
+        return ERR_NOMEM
+    # (b, c, v) (c, a, v) on t0's side; (a, d, v) (d, b, v) on t1's side
+    set_tri(T, t0, b, c, v, te1, NONE, NONE, ge1, 0, g, s0, r0)
+    set_tri(T, t2, c, a, v, te2, NONE, 3 * t0 + 1, ge2, g, 0, s0, r0)
+    set_tri(T, t1, a, d, v, tf1, NONE, 3 * t2 + 1, gf1, 0, g, s1, r1)
+    set_tri(T, t3, d, b, v, tf2, 3 * t0 + 2, 3 * t1 + 1, gf2, g, 0, s1, r1)
+    if reserve_stack(T, 4):
+        return ERR_NOMEM
+    T.stack[0] = 3 * t0
+    T.stack[1] = 3 * t2
+    T.stack[2] = 3 * t1
+    T.stack[3] = 3 * t3
+    if not is_ghost(T, t0):
+        T.last = t0
+    return 4
+
+
+cdef int insert_vertex_at(Tri* T, int v, int loc, int where) noexcept nogil:
+    """Insert vertex v at a place found by locate() and restore the CDT by flips."""
+    cdef int n
+    if loc == LOC_IN_TRIANGLE or loc == LOC_OUTSIDE:
+        n = split_triangle(T, where, v)
+    elif loc == LOC_ON_EDGE:
+        n = split_edge(T, where, v)
+    else:
+        return ERR_INTERNAL
+    if n < 0:
+        return n
+    return lawson_after_insert(T, n)
+
+
+cdef int insert_vertex(Tri* T, int v, int start) noexcept nogil:
+    """Insert existing vertex v into the triangulation.  Returns v, or the index of an
+    existing vertex at the same place (v is then left unconnected), or an error."""
+    cdef int where = NONE
+    cdef int loc = locate(T, P(T, v), start, &where)
+    if loc < 0:
+        return loc
+    if loc == LOC_ON_VERTEX:
+        return where
+    cdef int res = insert_vertex_at(T, v, loc, where)
+    if res < 0:
+        return res
+    return v
+
+
+cdef int make_first_triangle(Tri* T, int a, int b, int c) noexcept nogil:
+    """Start the triangulation with the non-degenerate triangle (a, b, c) and its three
+    ghost triangles (a, b, c are put in counter-clockwise order here)."""
+    cdef int t, g0, g1, g2, tmp
+    if orient2d(P(T, a), P(T, b), P(T, c)) < 0:
+        tmp = b
+        b = c
+        c = tmp
+    t = new_triangle(T)
+    g0 = new_triangle(T)
+    g1 = new_triangle(T)
+    g2 = new_triangle(T)
+    if t < 0 or g0 < 0 or g1 < 0 or g2 < 0:
+        return ERR_NOMEM
+    # ghost gk sits across edge k of t: (b, a, G), (c, b, G), (a, c, G)
+    set_tri(T, t, a, b, c, NONE, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
+    set_tri(T, g0, b, a, GHOST, 3 * t, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
+    set_tri(T, g1, c, b, GHOST, 3 * t + 1, 3 * g0 + 2, NONE, 0, 0, 0, T_UNMESHED, 0)
+    set_tri(T, g2, a, c, GHOST, 3 * t + 2, 3 * g1 + 2, 3 * g0 + 1, 0, 0, 0, T_UNMESHED, 0)
+    T.last = t
+    return 0
+
+
+cdef int find_edge(Tri* T, int a, int b) noexcept nogil:
+    """The half-edge a->b, or NONE.  Rotates around a (counter-clockwise)."""
+    cdef int e0 = T.vhe[a]
+    cdef int e = e0
+    cdef int guard = 0
+    if e0 < 0:
+        return NONE
+    while True:
+        if T.tv[nxt(e)] == b:
+            return e
+        e = T.twin[prv(e)]
+        guard += 1
+        if e == e0 or guard > T.nt * 3 + 3:
+            return NONE

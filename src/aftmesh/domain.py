@@ -1,0 +1,357 @@
+"""Domain input -> a validated planar straight-line graph with regions.
+
+Accepted forms (see :func:`aftmesh.generate`):
+
+* a shapely ``Polygon`` or ``MultiPolygon`` (holes, parts touching at a point);
+* a shapely ``GeometryCollection``: its polygons are the domain, its ``LineString`` /
+  ``Point`` members inside them are internal constraints (cracks, interfaces, fixed
+  nodes);
+* a sequence of shapely polygons with disjoint interiors: a multi-region domain whose
+  shared boundaries are discretized once; ``Mesh.regions`` is the index in the sequence;
+* an (n, 2) array of coordinates: one polygon ring;
+* a Triangle-style dict (``vertices``, ``segments``, ``holes``, ``regions``) or the
+  path of a Triangle ``.poly`` file.
+
+Clean-up done and reported in ``Mesh.info['cleanup']``: repeated vertices, a repeated
+closing vertex, collinear runs, rings in either orientation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from os import PathLike
+
+import numpy as np
+import shapely
+from shapely.geometry import (GeometryCollection, LineString, MultiLineString, MultiPoint,
+                              MultiPolygon, Point, Polygon)
+
+from .errors import InvalidDomainError, InvalidInputError
+from .pslg import as_points, as_segments
+
+__all__ = ["Domain", "to_domain"]
+
+
+@dataclass
+class Domain:
+    """A PSLG plus what is needed to mesh it.
+
+    ``segment_source[k]`` numbers the input ring / constraint line segment k came from
+    (``source_names`` says which); ``polygons`` classify the pieces cut out by the
+    segments into regions (index in the list; outside all: not meshed).  Dict and
+    ``.poly`` inputs instead carry Triangle's ``holes`` and ``region_points``."""
+
+    vertices: np.ndarray
+    segments: np.ndarray
+    segment_source: np.ndarray
+    source_names: list[str]
+    polygons: list | None = None
+    holes: np.ndarray | None = None
+    region_points: np.ndarray | None = None
+    area: float | None = None
+    cleanup: list[str] = field(default_factory=list)
+
+
+def _is_coordinate_array(obj) -> bool:
+    if isinstance(obj, (str, bytes, dict)) or isinstance(obj, shapely.Geometry):
+        return False
+    try:
+        arr = np.asarray(obj, dtype=np.float64)
+    except (TypeError, ValueError):
+        return False
+    return arr.ndim == 2 and arr.shape[1] == 2
+
+
+def _polygon_parts(geom, where: str) -> list[Polygon]:
+    if isinstance(geom, Polygon):
+        return [geom]
+    if isinstance(geom, MultiPolygon):
+        return list(geom.geoms)
+    raise InvalidDomainError(f"{where} is a {geom.geom_type}, expected a Polygon")
+
+
+def _check_polygon(poly: Polygon, where: str) -> None:
+    coords = np.asarray(poly.exterior.coords) if not poly.is_empty else np.zeros((0, 2))
+    if poly.is_empty:
+        raise InvalidDomainError(f"{where} is empty")
+    for k, ring in enumerate([poly.exterior, *poly.interiors]):
+        c = np.asarray(ring.coords)
+        bad = ~np.isfinite(c).all(axis=1)
+        if bad.any():
+            name = "exterior ring" if k == 0 else f"hole {k - 1}"
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidDomainError(f"{where}, {name}: vertex {i} = {c[i].tolist()} is not finite")
+    if not poly.is_valid:
+        reason = shapely.is_valid_reason(poly)
+        ring = "its rings"
+        # name the ring that is invalid on its own, if one is
+        if not Polygon(poly.exterior).is_valid:
+            ring = "the exterior ring"
+        else:
+            for k, hole in enumerate(poly.interiors):
+                if not Polygon(hole).is_valid:
+                    ring = f"hole {k}"
+                    break
+                if not Polygon(poly.exterior).contains(Polygon(hole)):
+                    ring = f"hole {k} (not inside the exterior ring)"
+                    break
+        raise InvalidDomainError(f"{where} is not a valid polygon ({ring}): {reason}")
+    if not poly.area > 0:
+        raise InvalidDomainError(f"{where} has zero area (vertices {coords[:4].tolist()}...)")
+
+
+def _clean_ring(coords: np.ndarray, note: list[str], name: str, keep_collinear: bool):
+    """Drop the closing duplicate, repeated vertices and (optionally) collinear runs."""
+    c = np.asarray(coords, dtype=np.float64)
+    if len(c) > 1 and (c[0] == c[-1]).all():
+        c = c[:-1]
+    keep = np.ones(len(c), dtype=bool)
+    keep[1:] = (c[1:] != c[:-1]).any(axis=1)
+    if len(c) > 1 and (c[-1] == c[0]).all():
+        keep[-1] = False
+    if not keep.all():
+        note.append(f"{name}: removed {int((~keep).sum())} repeated vertices")
+        c = c[keep]
+    if not keep_collinear and len(c) > 3:
+        from ._kernel import py_orient2d
+        changed = True
+        removed = 0
+        while changed and len(c) > 3:
+            changed = False
+            n = len(c)
+            mask = np.ones(n, dtype=bool)
+            for i in range(n):
+                a, b, d = c[i - 1], c[i], c[(i + 1) % n]
+                if mask[i - 1] and py_orient2d(a[0], a[1], b[0], b[1], d[0], d[1]) == 0 \
+                        and np.dot(b - a, d - b) > 0:
+                    mask[i] = False
+                    removed += 1
+                    changed = True
+            c = c[mask]
+        if removed:
+            note.append(f"{name}: merged {removed} vertices of collinear runs")
+    return c
+
+
+def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: list[str],
+                  keep_vertices: bool) -> Domain:
+    note: list[str] = []
+    vertices: list[np.ndarray] = []
+    segments: list[np.ndarray] = []
+    sources: list[np.ndarray] = []
+    source_names: list[str] = []
+    offset = 0
+
+    def add_chain(c: np.ndarray, closed: bool, name: str):
+        nonlocal offset
+        n = len(c)
+        if n < 2:
+            return
+        idx = np.arange(n)
+        seg = np.c_[idx, (idx + 1) % n] if closed else np.c_[idx[:-1], idx[1:]]
+        vertices.append(c)
+        segments.append(seg + offset)
+        sources.append(np.full(len(seg), len(source_names)))
+        source_names.append(name)
+        offset += n
+
+    for k, poly in enumerate(polygons):
+        where = names[k]
+        rings = [("exterior ring", poly.exterior)] + [
+            (f"hole {i}", h) for i, h in enumerate(poly.interiors)]
+        for rname, ring in rings:
+            c = _clean_ring(np.asarray(ring.coords)[:, :2], note, f"{where}, {rname}",
+                            keep_collinear=keep_vertices)
+            add_chain(c, True, f"{where}, {rname}")
+    for k, line in enumerate(lines):
+        c = np.asarray(line.coords)[:, :2]
+        keep = np.ones(len(c), dtype=bool)
+        keep[1:] = (c[1:] != c[:-1]).any(axis=1)
+        add_chain(c[keep], False, f"constraint line {k}")
+    isolated = [np.asarray(p.coords)[:, :2] for p in points]
+    if isolated:
+        iso = np.concatenate(isolated)
+        vertices.append(iso)
+        offset += len(iso)
+    verts = np.concatenate(vertices) if vertices else np.zeros((0, 2))
+    segs = np.concatenate(segments) if segments else np.zeros((0, 2), dtype=np.int64)
+    src = np.concatenate(sources) if sources else np.zeros(0, dtype=np.int64)
+    verts, segs, src = _merge_and_node(verts, segs, src, note)
+    union_area = float(shapely.union_all(polygons).area)
+    return Domain(verts, segs.astype(np.int32), src.astype(np.int32), source_names,
+                  polygons=polygons, area=union_area, cleanup=note)
+
+
+def _merge_and_node(verts, segs, src, note):
+    """Merge coincident vertices, drop segments given twice (a boundary shared by two
+    regions), and split segments at input vertices lying exactly on them or at points
+    where two segments cross (shapely's noding finds those)."""
+    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    segs = inverse[segs]
+    key = np.sort(segs, axis=1)
+    _, first = np.unique(key, axis=0, return_index=True)
+    first.sort()
+    segs, src = segs[first], src[first]
+    if len(segs) == 0:
+        return uniq, segs, src
+    # noding: find crossings between segments (shapely, exact enough on inputs that
+    # really cross; touching at input vertices is handled by the CDT itself)
+    lines = shapely.linestrings(np.stack([uniq[segs[:, 0]], uniq[segs[:, 1]]], axis=1))
+    tree = shapely.STRtree(lines)
+    pairs = tree.query(lines, predicate="crosses")
+    pairs = pairs[:, pairs[0] < pairs[1]]
+    if pairs.shape[1] == 0:
+        return uniq, segs, src
+    # split each crossing segment at its crossing points
+    cuts: dict[int, list[np.ndarray]] = {}
+    for i, j in pairs.T:
+        inter = shapely.intersection(lines[i], lines[j])
+        for p in shapely.get_parts(inter):
+            if isinstance(p, Point):
+                xy = np.asarray(p.coords)[0, :2]
+                cuts.setdefault(int(i), []).append(xy)
+                cuts.setdefault(int(j), []).append(xy)
+    new_pts = [uniq]
+    new_segs = []
+    new_src = []
+    base = len(uniq)
+    extra: list[np.ndarray] = []
+    for k in range(len(segs)):
+        if k not in cuts:
+            new_segs.append(segs[k][None, :])
+            new_src.append([src[k]])
+            continue
+        a, b = uniq[segs[k, 0]], uniq[segs[k, 1]]
+        d = b - a
+        pts = np.unique(np.array(cuts[k]), axis=0)
+        t = (pts - a) @ d / (d @ d)
+        order = np.argsort(t)
+        chain = [segs[k, 0]]
+        for p in pts[order]:
+            extra.append(p)
+            chain.append(base + len(extra) - 1)
+        chain.append(segs[k, 1])
+        new_segs.append(np.c_[chain[:-1], chain[1:]])
+        new_src.append([src[k]] * (len(chain) - 1))
+    note.append(f"split {len(cuts)} segments at {pairs.shape[1]} crossings")
+    new_pts.append(np.array(extra).reshape(-1, 2))
+    verts = np.concatenate(new_pts)
+    segs = np.concatenate(new_segs)
+    src = np.concatenate([np.asarray(s) for s in new_src])
+    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
+    segs = inverse.reshape(-1)[segs]
+    keep = segs[:, 0] != segs[:, 1]
+    return uniq, segs[keep], src[keep]
+
+
+def _from_dict(d: dict) -> Domain:
+    if "vertices" not in d:
+        raise InvalidInputError("a domain dict needs 'vertices' (and usually 'segments')")
+    pts = as_points(d["vertices"], "vertices")
+    seg = as_segments(d.get("segments"), len(pts), pts)
+    holes = as_points(d.get("holes", np.zeros((0, 2))), "holes")
+    regions = d.get("regions")
+    reg = None
+    if regions is not None and len(regions):
+        try:
+            reg = np.asarray(regions, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(f"regions must be rows of (x, y, marker[, max_area]): {exc}") from None
+        if reg.ndim != 2 or reg.shape[1] < 3:
+            raise InvalidInputError(f"regions must have shape (r, 3) or (r, 4), got {reg.shape}")
+        reg = reg[:, :3]
+    markers = d.get("segment_markers")
+    src = np.arange(len(seg), dtype=np.int32) if markers is None else \
+        np.asarray(markers, dtype=np.int32).reshape(-1)
+    if len(src) != len(seg):
+        raise InvalidInputError(
+            f"segment_markers has {len(src)} entries for {len(seg)} segments")
+    return Domain(pts, seg, src, [f"segment {i}" for i in range(len(seg))],
+                  holes=holes, region_points=reg)
+
+
+def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
+    """Convert any accepted domain form into a :class:`Domain` (see module doc)."""
+    if isinstance(domain, (str, PathLike)):
+        from .io import read_poly
+        return _from_dict(read_poly(domain))
+    if isinstance(domain, dict):
+        return _from_dict(domain)
+    if isinstance(domain, shapely.Geometry):
+        polygons, lines, points = [], [], []
+        parts = shapely.get_parts(domain) if isinstance(domain, GeometryCollection) else [domain]
+        for part in parts:
+            if isinstance(part, (Polygon, MultiPolygon)):
+                polygons.extend(_polygon_parts(part, "the domain"))
+            elif isinstance(part, (LineString, MultiLineString)):
+                lines.extend(shapely.get_parts(part))
+            elif isinstance(part, (Point, MultiPoint)):
+                points.extend(shapely.get_parts(part))
+            else:
+                raise InvalidDomainError(f"cannot mesh a {part.geom_type}")
+        if not polygons:
+            raise InvalidDomainError("the domain has no polygon to mesh")
+        names = [f"polygon {k}" if len(polygons) > 1 else "the polygon"
+                 for k in range(len(polygons))]
+        for k, p in enumerate(polygons):
+            _check_polygon(p, names[k])
+        union = shapely.union_all(polygons)
+        for k, line in enumerate(lines):
+            if not union.buffer(1e-12 * max(1.0, union.length)).covers(line):
+                raise InvalidDomainError(f"constraint line {k} is not inside the domain")
+        for k, p in enumerate(points):
+            if not union.covers(p):
+                raise InvalidDomainError(
+                    f"fixed point {k} = {list(p.coords)[0]} is not inside the domain")
+        single = shapely.union_all(polygons)
+        return _from_shapely([single] if isinstance(single, Polygon) else polygons,
+                             lines, points,
+                             ["the polygon"] if isinstance(single, Polygon) else names,
+                             keep_vertices)
+    if _is_coordinate_array(domain):
+        arr = np.asarray(domain, dtype=np.float64)
+        bad = ~np.isfinite(arr).all(axis=1)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidDomainError(f"vertex {i} = {arr[i].tolist()} is not finite")
+        if len(arr) < 3:
+            raise InvalidDomainError(f"a polygon ring needs at least 3 vertices, got {len(arr)}")
+        poly = Polygon(arr)
+        _check_polygon(poly, "the polygon")
+        return _from_shapely([poly], [], [], ["the polygon"], keep_vertices)
+    try:
+        items = list(domain)
+    except TypeError:
+        raise InvalidDomainError(
+            f"cannot mesh a {type(domain).__name__}: give a shapely geometry, a sequence of "
+            "polygons, an (n, 2) array, a dict or a .poly path") from None
+    if not items:
+        raise InvalidDomainError("the domain is an empty sequence")
+    polygons = []
+    for k, item in enumerate(items):
+        if isinstance(item, shapely.Geometry):
+            poly = item
+        elif _is_coordinate_array(item):
+            poly = Polygon(np.asarray(item, dtype=np.float64))
+        else:
+            raise InvalidDomainError(f"region {k} is a {type(item).__name__}, expected a polygon")
+        for part in _polygon_parts(poly, f"region {k}"):
+            _check_polygon(part, f"region {k}")
+        polygons.append(poly)
+    for i in range(len(polygons)):
+        for j in range(i + 1, len(polygons)):
+            overlap = polygons[i].intersection(polygons[j]).area
+            if overlap > 1e-12 * min(polygons[i].area, polygons[j].area):
+                raise InvalidDomainError(
+                    f"regions {i} and {j} overlap (common area {overlap:.6g}): regions must "
+                    "have disjoint interiors")
+    flat: list[Polygon] = []
+    names: list[str] = []
+    for k, p in enumerate(polygons):
+        for part in _polygon_parts(p, f"region {k}"):
+            flat.append(part)
+            names.append(f"region {k}")
+    dom = _from_shapely(flat, [], [], names, keep_vertices)
+    dom.polygons = polygons
+    dom.area = float(sum(p.area for p in polygons))
+    return dom

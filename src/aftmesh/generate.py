@@ -1,0 +1,180 @@
+"""``aftmesh.generate``: a quality triangle mesh of a domain by Basic_aft."""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import shapely
+
+from .aft import Strategy, basic_aft
+from .boundary import discretize
+from .cdt import segment_markers
+from .domain import to_domain
+from .errors import InvalidDomainError, InvalidOptionError, InvalidSizeError
+from .mesh import Mesh
+from .pslg import build_cdt
+from .sizing import DEFAULT_GRADATION, make_size_field
+
+__all__ = ["generate"]
+
+_ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
+
+
+def _check_options(order, max_triangles, min_area, close_factor):
+    if order not in _ORDERS:
+        raise InvalidOptionError(
+            f"order={order!r} is not a valid option, must be one of {sorted(_ORDERS)}")
+    if max_triangles is not None:
+        if isinstance(max_triangles, bool) or not isinstance(max_triangles, (int, np.integer)):
+            raise InvalidOptionError(f"max_triangles must be an integer, got {max_triangles!r}")
+        if max_triangles < 1:
+            raise InvalidOptionError(f"max_triangles must be positive, got {max_triangles}")
+    if min_area is not None and not (np.isfinite(min_area) and min_area >= 0):
+        raise InvalidOptionError(f"min_area must be a finite number >= 0, got {min_area!r}")
+    if not (np.isfinite(close_factor) and 0 <= close_factor < 2):
+        raise InvalidOptionError(f"close_factor must be in [0, 2), got {close_factor!r}")
+
+
+def generate(domain, size=None, *, max_triangles: int | None = None,
+             min_area: float | None = None, order: str = "shortest", greedy: bool = False,
+             swaps: bool = True, split_boundary: bool = True,
+             gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
+             strategy: Strategy | None = None) -> Mesh:
+    """Mesh a 2D domain with triangles by the advancing-front technique.
+
+    Parameters
+    ----------
+    domain
+        A shapely ``Polygon`` / ``MultiPolygon`` / ``GeometryCollection`` (lines and
+        points inside the polygons become internal constraints), a sequence of
+        polygons with disjoint interiors (one region each), an (n, 2) coordinate array
+        (one ring), a Triangle-style dict (``vertices``, ``segments``, ``holes``,
+        ``regions``), or the path of a ``.poly`` file.
+    size : float, callable or None
+        Target edge length: a number, ``f(x, y) -> array`` (called on whole arrays), or
+        None to take it from the lengths of the input edges.
+    max_triangles : int, optional
+        N_max: the mesh never has more triangles (formula (4) of the paper).
+    min_area : float, optional
+        A_min: no new vertex whose triangle would be smaller (formula (5)).  By default
+        1 % of the area of an equilateral triangle of the smallest size.
+    order : {'shortest', 'longest', 'oldest'}
+        Get_next_edge: shortest front edge first (default), longest first, or oldest
+        first (layer by layer).
+    greedy : bool
+        New_is_preferred always false: no point is added and the result is a
+        triangulation of the (discretized) input vertices.
+    swaps : bool
+        Add_triangle keeps the meshed region a constrained Delaunay triangulation by
+        edge swaps (default), so the final mesh is the CDT of its vertices and the
+        input edges.
+    split_boundary : bool
+        Split input edges according to the size (default) or keep them exactly as
+        given (the paper's assumption).
+    gradation : float
+        Bound on how fast the size may grow, per unit of its own length (>= 1).
+    close_factor : float
+        New_is_preferred refuses R when S, or a vertex R would be joined to, is closer
+        than ``close_factor * h`` (a constrained edge: half that).
+    strategy : Strategy, optional
+        Subtasks to plug in (see :class:`aftmesh.aft.Strategy`); the Python loop runs
+        then, otherwise the compiled one.
+
+    Returns
+    -------
+    Mesh
+
+    Examples
+    --------
+    >>> import aftmesh
+    >>> from shapely.geometry import Point, box
+    >>> domain = box(0, 0, 2, 1).difference(Point(0.5, 0.5).buffer(0.2))
+    >>> mesh = aftmesh.generate(domain, size=0.1)
+    >>> mesh.quality()["min_angle"] > 20
+    True
+    >>> abs(mesh.area() - domain.area) < 1e-9
+    True
+    """
+    t_start = time.perf_counter()
+    _check_options(order, max_triangles, min_area, close_factor)
+    dom = to_domain(domain, keep_vertices=not split_boundary)
+    if len(dom.vertices) < 3:
+        raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
+    lo = dom.vertices.min(axis=0)
+    hi = dom.vertices.max(axis=0)
+    lengths = None
+    if size is None:
+        seg = dom.segments
+        if len(seg) == 0:
+            raise InvalidSizeError("size=None takes the size from the input edges, but there are none")
+        L = np.linalg.norm(dom.vertices[seg[:, 1]] - dom.vertices[seg[:, 0]], axis=1)
+        lengths = np.zeros(len(dom.vertices))
+        count = np.zeros(len(dom.vertices))
+        np.add.at(lengths, seg.ravel(), np.repeat(L, 2))
+        np.add.at(count, seg.ravel(), 1)
+        used = count > 0
+        lengths = lengths[used] / count[used]
+        field = make_size_field(None, (lo, hi), dom.vertices[used], lengths, gradation)
+    else:
+        field = make_size_field(size, (lo, hi), gradation=gradation)
+    if split_boundary:
+        verts, segs, src = discretize(dom.vertices, dom.segments, dom.segment_source, field)
+    else:
+        verts, segs, src = dom.vertices, dom.segments, dom.segment_source
+    t_boundary = time.perf_counter()
+    area_hint = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
+    nt_hint = int(min(4e8, 2.5 * area_hint / (0.43 * field.h_min ** 2) + 4 * len(verts)))
+    built = build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
+                      nt_hint=min(nt_hint, 50_000_000))
+    kernel = built.kernel
+    if dom.polygons is not None:
+        comp, probes = kernel.components()
+        region_of = np.full(len(probes), -1, dtype=np.int32)
+        for k, poly in enumerate(dom.polygons):
+            inside = shapely.contains_xy(poly, probes[:, 0], probes[:, 1])
+            region_of[inside & (region_of < 0)] = k
+        kernel.set_regions(comp, region_of)
+    n_ext, n_unmeshed, _ = kernel.state_counts()
+    if n_unmeshed == 0:
+        raise InvalidDomainError(
+            "the domain encloses no area (are the segments closed rings? are all regions holes?)")
+    if max_triangles is not None and n_unmeshed > max_triangles:
+        raise InvalidSizeError(
+            f"max_triangles={max_triangles} is below the {n_unmeshed} triangles any "
+            "triangulation of this boundary needs (formula (3))")
+    if min_area is None:
+        min_area = 0.01 * (np.sqrt(3) / 4) * field.h_min ** 2
+    kernel.set_size_grid(field.x0, field.y0, field.dx, field.dy, field.h)
+    kernel.set_options(order=_ORDERS[order],
+                       max_triangles=-1 if max_triangles is None else int(max_triangles),
+                       min_area=float(min_area), close_factor=float(close_factor),
+                       swaps=bool(swaps), greedy=bool(greedy))
+    t_cdt = time.perf_counter()
+    compiled = strategy is None or strategy.is_builtin
+    if compiled:
+        kernel.convert_to_frontal_edge_set()
+        kernel.run()
+    else:
+        basic_aft(kernel, strategy)
+        if kernel.counters()["unmeshed"] != 0:
+            raise InvalidOptionError(
+                "the strategy's get_next_edge returned -1 while front edges remained")
+    t_aft = time.perf_counter()
+    a = kernel.arrays()
+    to_out = a["vertex_map"][built.merged]
+    pieces = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
+    markers = np.where(pieces >= 0, src[np.maximum(pieces, 0)], -1).astype(np.int32)
+    counters = kernel.counters()
+    info = {
+        "merged_vertices": built.n_merged,
+        "cleanup": dom.cleanup,
+        "sources": dom.source_names,
+        "new_vertices": counters["new_vertices"],
+        "compiled_loop": compiled,
+        "size_field": field,
+        "timing": {"boundary": t_boundary - t_start, "cdt": t_cdt - t_boundary,
+                   "basic_aft": t_aft - t_cdt, "total": time.perf_counter() - t_start},
+    }
+    return Mesh(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
+                segments=a["segments"], regions=a["regions"], segment_markers=markers,
+                info=info)

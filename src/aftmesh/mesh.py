@@ -1,0 +1,202 @@
+"""The result object: a small immutable mesh of plain numpy arrays."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Mesh", "triangle_quality"]
+
+
+def _frozen(a, dtype) -> np.ndarray:
+    arr = np.array(a, dtype=dtype, copy=True)
+    arr.setflags(write=False)
+    return arr
+
+
+def triangle_quality(points: np.ndarray, triangles: np.ndarray) -> dict[str, np.ndarray]:
+    """Per-triangle shape measures.
+
+    Returns a dict of arrays: ``radius_ratio`` (2 r_in / r_circ: 1 for an equilateral
+    triangle, 0 for a degenerate one), ``min_angle`` and ``max_angle`` in degrees,
+    ``area``, and ``edge_lengths`` (t, 3) with column k the edge opposite vertex k.
+    """
+    p = points[triangles]
+    e = np.stack([p[:, 2] - p[:, 1], p[:, 0] - p[:, 2], p[:, 1] - p[:, 0]], axis=1)
+    lengths = np.linalg.norm(e, axis=2)
+    a, b, c = lengths[:, 0], lengths[:, 1], lengths[:, 2]
+    area = 0.5 * (e[:, 2, 0] * (-e[:, 1, 1]) - e[:, 2, 1] * (-e[:, 1, 0]))
+    perimeter = a + b + c
+    with np.errstate(divide="ignore", invalid="ignore"):
+        # 2 r_in / r_circ = 16 area^2 / (perimeter a b c)
+        rr = np.where(area > 0, 16.0 * area * area / (perimeter * a * b * c), 0.0)
+        cos = np.stack([(b * b + c * c - a * a) / (2 * b * c),
+                        (c * c + a * a - b * b) / (2 * c * a),
+                        (a * a + b * b - c * c) / (2 * a * b)], axis=1)
+    ang = np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), -1.0, 1.0)))
+    return dict(radius_ratio=rr, min_angle=ang.min(axis=1), max_angle=ang.max(axis=1),
+                area=area, edge_lengths=lengths)
+
+
+@dataclass(frozen=True, repr=False, eq=False)
+class Mesh:
+    """A 2D triangle mesh.
+
+    Attributes
+    ----------
+    points : (n, 2) float64
+        Vertex coordinates; every point is used by some triangle.
+    triangles : (t, 3) int32
+        Vertex indices of each triangle, counter-clockwise.
+    neighbors : (t, 3) int32
+        ``neighbors[i, k]`` is the triangle across the edge opposite vertex
+        ``triangles[i, k]``, or -1 on the boundary.
+    segments : (s, 2) int32
+        The constrained edges (input edges and the pieces they were split into).
+    segment_markers : (s,) int32
+        For each segment, the input segment (or ring edge) it came from, -1 if unknown.
+    regions : (t,) int32
+        Region marker of each triangle.
+    info : dict
+        What happened on the way: merged vertices, counters, timings.
+    """
+
+    points: np.ndarray
+    triangles: np.ndarray
+    neighbors: np.ndarray
+    segments: np.ndarray
+    regions: np.ndarray
+    segment_markers: np.ndarray | None = None
+    info: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self):
+        object.__setattr__(self, "points", _frozen(self.points, np.float64).reshape(-1, 2))
+        object.__setattr__(self, "triangles", _frozen(self.triangles, np.int32).reshape(-1, 3))
+        object.__setattr__(self, "neighbors", _frozen(self.neighbors, np.int32).reshape(-1, 3))
+        object.__setattr__(self, "segments", _frozen(self.segments, np.int32).reshape(-1, 2))
+        object.__setattr__(self, "regions", _frozen(self.regions, np.int32).reshape(-1))
+        markers = self.segment_markers
+        if markers is None:
+            markers = np.full(len(self.segments), -1, dtype=np.int32)
+        object.__setattr__(self, "segment_markers", _frozen(markers, np.int32).reshape(-1))
+
+    @property
+    def n_points(self) -> int:
+        return len(self.points)
+
+    @property
+    def n_triangles(self) -> int:
+        return len(self.triangles)
+
+    @property
+    def edges(self) -> np.ndarray:
+        """(e, 2) int32: each edge of the mesh once, as sorted vertex pairs."""
+        t = self.triangles
+        e = np.concatenate([t[:, [1, 2]], t[:, [2, 0]], t[:, [0, 1]]])
+        e.sort(axis=1)
+        return np.unique(e, axis=0).astype(np.int32)
+
+    def area(self) -> float:
+        """Total area of the triangles."""
+        return float(triangle_quality(self.points, self.triangles)["area"].sum())
+
+    def quality(self, size=None, bins: int = 10) -> dict[str, Any]:
+        """Summary of the triangles' shapes.
+
+        Parameters
+        ----------
+        size : float or callable, optional
+            Target edge length (a number or ``f(x, y) -> array``): adds the statistics
+            of edge length / target size.
+        bins : int
+            Number of bins of the radius-ratio histogram over [0, 1].
+
+        Returns
+        -------
+        dict
+            ``min_angle``, ``max_angle`` (degrees), ``radius_ratio_mean``,
+            ``radius_ratio_min``, ``fraction_rr_above_0.9``, ``fraction_rr_below_0.6``,
+            ``radius_ratio_histogram`` (counts, edges), ``edge_length_mean``, and with a
+            size, ``edge_to_size_mean`` and ``edge_to_size_std``.
+
+        Examples
+        --------
+        >>> import aftmesh
+        >>> m = aftmesh.generate([(0, 0), (1, 0), (1, 1), (0, 1)], size=0.2)
+        >>> m.quality()["min_angle"] > 20
+        True
+        """
+        q = triangle_quality(self.points, self.triangles)
+        rr = q["radius_ratio"]
+        edges = self.edges
+        lengths = np.linalg.norm(self.points[edges[:, 1]] - self.points[edges[:, 0]], axis=1)
+        counts, edges_hist = np.histogram(rr, bins=bins, range=(0.0, 1.0))
+        out: dict[str, Any] = {
+            "triangles": self.n_triangles,
+            "points": self.n_points,
+            "min_angle": float(q["min_angle"].min()) if len(rr) else float("nan"),
+            "max_angle": float(q["max_angle"].max()) if len(rr) else float("nan"),
+            "radius_ratio_mean": float(rr.mean()) if len(rr) else float("nan"),
+            "radius_ratio_min": float(rr.min()) if len(rr) else float("nan"),
+            "fraction_rr_above_0.9": float((rr > 0.9).mean()) if len(rr) else float("nan"),
+            "fraction_rr_below_0.6": float((rr < 0.6).mean()) if len(rr) else float("nan"),
+            "radius_ratio_histogram": (counts, edges_hist),
+            "edge_length_mean": float(lengths.mean()) if len(lengths) else float("nan"),
+        }
+        if size is not None:
+            mid = 0.5 * (self.points[edges[:, 0]] + self.points[edges[:, 1]])
+            if callable(size):
+                target = np.asarray(size(mid[:, 0], mid[:, 1]), dtype=float)
+                target = np.broadcast_to(target, lengths.shape)
+            else:
+                target = np.full(lengths.shape, float(size))
+            ratio = lengths / target
+            out["edge_to_size_mean"] = float(ratio.mean())
+            out["edge_to_size_std"] = float(ratio.std())
+        return out
+
+    def __repr__(self) -> str:
+        lines = [f"aftmesh.Mesh: {self.n_points} points, {self.n_triangles} triangles, "
+                 f"{len(self.segments)} segments"]
+        if self.n_triangles:
+            lo = self.points.min(axis=0)
+            hi = self.points.max(axis=0)
+            q = triangle_quality(self.points, self.triangles)
+            lines.append(f"  bounds: x [{lo[0]:.6g}, {hi[0]:.6g}], y [{lo[1]:.6g}, {hi[1]:.6g}]")
+            regions = np.unique(self.regions)
+            lines.append(f"  regions: {regions.tolist() if len(regions) <= 8 else len(regions)}")
+            lines.append(f"  angles: min {q['min_angle'].min():.2f} deg, max {q['max_angle'].max():.2f} deg;"
+                         f" radius ratio mean {q['radius_ratio'].mean():.4f}")
+        return "\n".join(lines)
+
+    def write(self, path, file_format: str | None = None) -> None:
+        """Write the mesh to a file.
+
+        ``.poly``, ``.node`` and ``.ele`` (Triangle's formats) are written natively: a
+        ``.node`` path also writes the ``.ele`` beside it and vice versa.  Every other
+        format (``.vtu``, ``.msh``, ``.xdmf``, ...) goes through meshio (``pip install
+        aftmesh[io]``), with the region of each triangle as cell data ``region``.
+        """
+        from . import io as _io
+        _io.write_mesh(self, Path(path), file_format)
+
+    def plot(self, ax=None, color_by: str = "quality", show_segments: bool = True, **kwargs):
+        """Draw the mesh with matplotlib (``pip install aftmesh[plot]``).
+
+        Parameters
+        ----------
+        ax : matplotlib Axes, optional
+        color_by : {'quality', 'region', 'none'}
+            Fill each triangle by its radius ratio, by its region, or leave it white.
+        show_segments : bool
+            Draw the constrained edges on top, thicker.
+
+        Returns
+        -------
+        matplotlib Axes
+        """
+        from . import plotting
+        return plotting.plot_mesh(self, ax=ax, color_by=color_by,
+                                  show_segments=show_segments, **kwargs)

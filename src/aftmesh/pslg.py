@@ -1,0 +1,167 @@
+"""Validate a planar straight-line graph (PSLG) and build its constrained Delaunay
+triangulation in the kernel.  Shared by :func:`aftmesh.cdt` and :func:`aftmesh.generate`.
+
+Policies (stated once, here):
+
+* Exactly coincident input vertices are merged; the merge is reported in
+  ``Mesh.info['merged_vertices']``.
+* A segment that runs exactly through another input vertex is split there.
+* Two segments that cross at a point interior to both raise
+  :class:`~aftmesh.errors.CrossingSegmentsError` naming both.
+* With segments, every triangle reachable from outside the convex hull without
+  crossing a segment is removed (so only regions enclosed by segments remain), then
+  every region reachable from a hole point.  Without segments the convex hull is kept.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _kernel
+from ._order import brio_order
+from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
+
+# Coordinates beyond this magnitude could overflow the exact predicates' intermediate
+# products (they square and cube differences of coordinates).
+MAX_COORDINATE = 1e100
+
+
+@dataclass
+class BuiltCDT:
+    kernel: _kernel.Triangulation
+    vertices: np.ndarray        # (n, 2) the validated input vertices
+    segments: np.ndarray        # (m, 2) segments in input vertex numbering
+    merged: np.ndarray          # (n,) input vertex -> kernel vertex it was merged into
+    n_merged: int
+
+
+def as_points(value, name: str) -> np.ndarray:
+    """An (n, 2) float64 array of finite coordinates, or an error naming the bad row."""
+    try:
+        arr = np.asarray(value, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"{name} must be an (n, 2) array of numbers: {exc}") from None
+    if arr.size == 0:
+        return np.zeros((0, 2), dtype=np.float64)
+    if arr.ndim != 2 or arr.shape[1] != 2:
+        raise InvalidInputError(f"{name} must have shape (n, 2), got {arr.shape}")
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        i = int(np.flatnonzero(bad)[0])
+        raise InvalidInputError(f"{name}[{i}] = {arr[i].tolist()} is not finite")
+    big = np.abs(arr).max(axis=1) > MAX_COORDINATE
+    if big.any():
+        i = int(np.flatnonzero(big)[0])
+        raise InvalidInputError(
+            f"{name}[{i}] = {arr[i].tolist()} is too large (|coordinate| > {MAX_COORDINATE:g})")
+    return np.ascontiguousarray(arr)
+
+
+def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
+    if value is None:
+        return np.zeros((0, 2), dtype=np.int32)
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError) as exc:
+        raise InvalidInputError(f"segments must be an (m, 2) array of indices: {exc}") from None
+    if raw.size == 0:
+        return np.zeros((0, 2), dtype=np.int32)
+    if raw.ndim != 2 or raw.shape[1] != 2:
+        raise InvalidInputError(f"segments must have shape (m, 2), got {raw.shape}")
+    if not np.issubdtype(raw.dtype, np.integer):
+        as_int = raw.astype(np.int64) if np.issubdtype(raw.dtype, np.number) else None
+        if as_int is None or not np.array_equal(as_int, raw):
+            raise InvalidInputError("segments must hold integer vertex indices")
+        raw = as_int
+    seg = raw.astype(np.int64)
+    bad = (seg < 0) | (seg >= n_vertices)
+    if bad.any():
+        i = int(np.flatnonzero(bad.any(axis=1))[0])
+        raise InvalidInputError(
+            f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{n_vertices - 1}")
+    zero = (seg[:, 0] == seg[:, 1]) | (vertices[seg[:, 0]] == vertices[seg[:, 1]]).all(axis=1)
+    if zero.any():
+        i = int(np.flatnonzero(zero)[0])
+        raise InvalidInputError(
+            f"segments[{i}] = {seg[i].tolist()} has zero length "
+            f"(both ends at {vertices[seg[i, 0]].tolist()})")
+    return seg.astype(np.int32)
+
+
+def _segment_containing(vertices, segments, u, v):
+    """Index of the input segment that the kernel edge (u, v) is (a piece of)."""
+    pu, pv = vertices[u], vertices[v]
+    for j, (a, b) in enumerate(segments):
+        if {int(a), int(b)} == {u, v}:
+            return j
+    for j, (a, b) in enumerate(segments):
+        pa, pb = vertices[a], vertices[b]
+        d = pb - pa
+        cu = d[0] * (pu[1] - pa[1]) - d[1] * (pu[0] - pa[0])
+        cv = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
+        if cu == 0 and cv == 0:
+            tu = np.dot(pu - pa, d) / np.dot(d, d)
+            tv = np.dot(pv - pa, d) / np.dot(d, d)
+            if -1e-12 <= min(tu, tv) and max(tu, tv) <= 1 + 1e-12:
+                return j
+    return -1
+
+
+def build_cdt(vertices, segments=None, holes=None, regions=None, *,
+              carve: bool | None = None, nt_hint: int = 0) -> BuiltCDT:
+    """Validate a PSLG and return the kernel triangulation of its domain.
+
+    ``regions`` is a sequence of (x, y, marker) rows; ``holes`` an (h, 2) array.
+    ``carve`` (default: whether there are segments) removes what lies outside all
+    closed rings of segments."""
+    pts = as_points(vertices, "vertices")
+    n = len(pts)
+    if n < 3:
+        raise InvalidDomainError(f"need at least 3 vertices, got {n}")
+    seg = as_segments(segments, n, pts)
+    hole_pts = as_points(holes if holes is not None else np.zeros((0, 2)), "holes")
+    if regions is None:
+        reg = np.zeros((0, 3))
+    else:
+        try:
+            reg = np.asarray(regions, dtype=np.float64).reshape(-1, 3)
+        except (TypeError, ValueError) as exc:
+            raise InvalidInputError(f"regions must be rows of (x, y, marker): {exc}") from None
+        if not np.isfinite(reg).all():
+            i = int(np.flatnonzero(~np.isfinite(reg).all(axis=1))[0])
+            raise InvalidInputError(f"regions[{i}] = {reg[i].tolist()} is not finite")
+    kernel = _kernel.Triangulation(pts, nt_hint)
+    try:
+        merged = kernel.insert_points(brio_order(pts))
+    except _kernel.CollinearError:
+        raise InvalidDomainError(
+            f"all {n} vertices are collinear: there is no triangle to make") from None
+    n_merged = int((merged != np.arange(n)).sum())
+    kseg = merged[seg] if len(seg) else seg
+    try:
+        kernel.insert_segments(np.ascontiguousarray(kseg, dtype=np.int32))
+    except _kernel.CrossingError as err:
+        i = err.index
+        j = _segment_containing(pts, seg, *err.blocker)
+        a, b = seg[i]
+        if j >= 0:
+            c, d = seg[j]
+            msg = (f"segments[{i}] = [{a}, {b}] ({pts[a].tolist()} -> {pts[b].tolist()}) "
+                   f"crosses segments[{j}] = [{c}, {d}] ({pts[c].tolist()} -> {pts[d].tolist()})")
+            raise CrossingSegmentsError(msg, (i, j)) from None
+        raise CrossingSegmentsError(
+            f"segments[{i}] = [{a}, {b}] crosses another segment", (i,)) from None
+    if carve is None:
+        carve = len(seg) > 0
+    kernel.carve(np.zeros((0, 2)), carve)
+    for name, rows in (("holes", hole_pts), ("regions", reg[:, :2])):
+        for i, (x, y) in enumerate(rows):
+            if kernel.state_at(x, y) != 2:
+                raise InvalidDomainError(
+                    f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain")
+    kernel.carve(hole_pts, False)
+    if len(reg):
+        kernel.assign_regions(np.ascontiguousarray(reg[:, :2]),
+                              np.ascontiguousarray(reg[:, 2].astype(np.int32)))
+    return BuiltCDT(kernel, pts, seg, merged, n_merged)

@@ -1,0 +1,169 @@
+"""Size specifications -> the compiled size field (a background grid).
+
+A user's ``size`` is a number (the target edge length everywhere), a callable
+``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point), or
+``None`` (sizes taken from the lengths of the boundary's own edges and spread inward).
+Whatever it is, it becomes a regular grid of target lengths that the kernel
+interpolates bilinearly, after a gradation limit has been applied so that the size
+never grows faster than ``gradation`` per unit of length relative to itself
+(h(x) <= h(y) + (gradation - 1) |x - y|).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .errors import InvalidSizeError
+
+__all__ = ["SizeField", "make_size_field"]
+
+# The background grid has at most this many nodes along its longer side.
+MAX_GRID = 1024
+DEFAULT_GRADATION = 1.3
+
+
+@dataclass(frozen=True)
+class SizeField:
+    """Target edge length on a regular grid: ``h[j, i]`` at ``(x0 + i dx, y0 + j dy)``."""
+
+    x0: float
+    y0: float
+    dx: float
+    dy: float
+    h: np.ndarray
+
+    @property
+    def h_min(self) -> float:
+        return float(self.h.min())
+
+    def __call__(self, x, y) -> np.ndarray:
+        """Bilinear interpolation, clamped outside the grid (as the kernel does it)."""
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        ny, nx = self.h.shape
+        if nx == 1 and ny == 1:
+            return np.full(np.broadcast(x, y).shape, self.h[0, 0])
+        fx = np.clip((x - self.x0) / self.dx, 0, nx - 1) if nx > 1 else np.zeros_like(x)
+        fy = np.clip((y - self.y0) / self.dy, 0, ny - 1) if ny > 1 else np.zeros_like(y)
+        i = np.minimum(fx.astype(np.int64), max(nx - 2, 0))
+        j = np.minimum(fy.astype(np.int64), max(ny - 2, 0))
+        tx = fx - i
+        ty = fy - j
+        i1 = np.minimum(i + 1, nx - 1)
+        j1 = np.minimum(j + 1, ny - 1)
+        h = self.h
+        return ((1 - ty) * ((1 - tx) * h[j, i] + tx * h[j, i1])
+                + ty * ((1 - tx) * h[j1, i] + tx * h[j1, i1]))
+
+
+def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> None:
+    bad = ~(np.isfinite(h) & (h > 0))
+    if bad.any():
+        k = np.flatnonzero(bad.ravel())[0]
+        raise InvalidSizeError(
+            f"{what} gave {h.ravel()[k]!r} at ({X.ravel()[k]:.6g}, {Y.ravel()[k]:.6g}): "
+            "sizes must be finite and positive")
+
+
+def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    try:
+        out = size(X, Y)
+    except Exception as exc:  # the user's function failed: say so, keep the cause
+        raise InvalidSizeError(f"the size callable raised {type(exc).__name__}: {exc}") from exc
+    try:
+        h = np.broadcast_to(np.asarray(out, dtype=np.float64), X.shape).copy()
+    except (TypeError, ValueError) as exc:
+        raise InvalidSizeError(
+            f"the size callable must return numbers broadcastable to shape {X.shape} "
+            f"(it is called with two arrays): {exc}") from None
+    _check_values(h, X, Y, "the size callable")
+    return h
+
+
+def limit_gradation(h: np.ndarray, dx: float, dy: float, gradation: float) -> np.ndarray:
+    """Smallest field <= h with h(x) <= h(y) + (gradation - 1) * |x - y| between grid
+    nodes (distances along rows and columns, repeated so diagonals are covered)."""
+    if gradation <= 1.0 or h.size <= 1:
+        return h
+    g = gradation - 1.0
+    h = h.copy()
+    ny, nx = h.shape
+    ix = np.arange(nx) * dx * g
+    iy = np.arange(ny) * dy * g
+    for _ in range(2):
+        if nx > 1:
+            h = np.minimum(h, np.minimum.accumulate(h - ix, axis=1) + ix)
+            h = np.minimum(h, (np.minimum.accumulate((h + ix)[:, ::-1], axis=1))[:, ::-1] - ix)
+        if ny > 1:
+            h = np.minimum(h, np.minimum.accumulate(h - iy[:, None], axis=0) + iy[:, None])
+            h = np.minimum(h, (np.minimum.accumulate((h + iy[:, None])[::-1], axis=0))[::-1]
+                           - iy[:, None])
+    return h
+
+
+def _grid(bounds, spacing: float):
+    (xmin, ymin), (xmax, ymax) = bounds
+    span = max(xmax - xmin, ymax - ymin)
+    spacing = max(spacing, span / (MAX_GRID - 1))
+    nx = int(np.ceil((xmax - xmin) / spacing)) + 1
+    ny = int(np.ceil((ymax - ymin) / spacing)) + 1
+    nx = max(nx, 2)
+    ny = max(ny, 2)
+    dx = (xmax - xmin) / (nx - 1) if xmax > xmin else 1.0
+    dy = (ymax - ymin) / (ny - 1) if ymax > ymin else 1.0
+    xs = xmin + dx * np.arange(nx)
+    ys = ymin + dy * np.arange(ny)
+    X, Y = np.meshgrid(xs, ys)
+    return xmin, ymin, dx, dy, X, Y
+
+
+def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
+                    gradation: float = DEFAULT_GRADATION) -> SizeField:
+    """Turn a size specification into a :class:`SizeField` over ``bounds``.
+
+    Parameters
+    ----------
+    size : float, callable or None
+    bounds : ((xmin, ymin), (xmax, ymax))
+    boundary_points, boundary_lengths : arrays, for ``size=None``: the input vertices and
+        the mean length of the input edges at each.
+    gradation : float >= 1
+        Largest growth factor of the size per its own length; 1 means no limit.
+    """
+    if gradation is None or not np.isfinite(gradation) or gradation < 1.0:
+        raise InvalidSizeError(f"gradation must be a finite number >= 1, got {gradation!r}")
+    if size is not None and not callable(size):
+        try:
+            value = float(size)
+        except (TypeError, ValueError):
+            raise InvalidSizeError(
+                f"size must be a number, a callable f(x, y) or None, got {size!r}") from None
+        if not (np.isfinite(value) and value > 0):
+            raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
+        return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[value]]))
+    (xmin, ymin), (xmax, ymax) = bounds
+    span = max(xmax - xmin, ymax - ymin)
+    pad = 0.02 * span
+    bounds = ((xmin - pad, ymin - pad), (xmax + pad, ymax + pad))
+    if callable(size):
+        # a coarse look first, to pick a grid spacing fine enough for the smallest size
+        x0, y0, dx, dy, X, Y = _grid(bounds, span / 64)
+        h0 = _evaluate(size, X, Y)
+        x0, y0, dx, dy, X, Y = _grid(bounds, 0.5 * float(h0.min()))
+        h = _evaluate(size, X, Y)
+    else:
+        pts = np.asarray(boundary_points, dtype=np.float64)
+        lengths = np.asarray(boundary_lengths, dtype=np.float64)
+        x0, y0, dx, dy, X, Y = _grid(bounds, 0.5 * float(lengths.min()))
+        h = np.full(X.shape, np.inf)
+        # seed each boundary vertex's size at its nearest grid node, then spread
+        i = np.clip(np.rint((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 1)
+        j = np.clip(np.rint((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 1)
+        np.minimum.at(h, (j, i), lengths)
+        if gradation <= 1.0:
+            gradation = DEFAULT_GRADATION
+    h = limit_gradation(h, dx, dy, gradation)
+    if not np.isfinite(h).all():
+        raise InvalidSizeError("could not derive a size from the boundary")
+    return SizeField(float(x0), float(y0), float(dx), float(dy), np.ascontiguousarray(h))

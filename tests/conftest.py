@@ -1,0 +1,35 @@
+"""Shared test set-up: hypothesis profiles and the invariant checker fixture.
+
+Profiles (select with AFTMESH_TEST_PROFILE): ``ci`` (default: bounded, derandomized so
+every run tries the same examples), ``long`` (many more examples, for fuzzing
+sessions; failures found there are pinned as named regression tests).
+"""
+import os
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, settings
+
+from aftmesh.checks import check_mesh
+
+settings.register_profile(
+    "ci", max_examples=60, derandomize=True, deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.register_profile(
+    "long", max_examples=2000, derandomize=False, deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+settings.load_profile(os.environ.get("AFTMESH_TEST_PROFILE", "ci"))
+
+
+@pytest.fixture
+def rng():
+    return np.random.default_rng(12345)
+
+
+@pytest.fixture
+def checked():
+    """``checked(mesh, **kw)`` runs the invariant checker and returns the mesh."""
+    def run(mesh, **kw):
+        check_mesh(mesh, **kw)
+        return mesh
+    return run
