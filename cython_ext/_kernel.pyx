@@ -29,6 +29,7 @@ include "triangulation.pxi"
 include "cdt.pxi"
 include "sizing.pxi"
 include "front.pxi"
+include "smoothing.pxi"
 
 
 class KernelError(RuntimeError):
@@ -89,6 +90,7 @@ cdef class Triangulation:
     cdef Aft A
     cdef int vis_edge           # the (edge, R) that check_visible last answered for
     cdef double vis_R[2]
+    cdef object progress        # keeps alive the callable A.progress points to
 
     def __cinit__(self, const double[:, ::1] points, int nt_hint=0):
         cdef int n = points.shape[0], i
@@ -573,16 +575,33 @@ cdef class Triangulation:
         self.A.n_steps += 1
         _raise_for(&self.T, add_triangle(&self.A, &self.T, t))
 
-    def run(self):
-        """The compiled Basic_aft loop with the built-in subtasks (GIL released)."""
+    def run(self, progress=None):
+        """The compiled Basic_aft loop with the built-in subtasks (GIL released).
+        `progress`, if given, is called now and then with the meshed fraction of the
+        area (exceptions it raises are ignored)."""
         cdef int res
-        with nogil:
-            res = basic_aft_loop(&self.A, &self.T)
+        self.progress = progress
+        self.A.progress = <void*> progress if progress is not None else NULL
+        try:
+            with nogil:
+                res = basic_aft_loop(&self.A, &self.T)
+        finally:
+            self.A.progress = NULL
+            self.progress = None
         _raise_for(&self.T, res)
         if DEBUG:
             problems = self.validate()
             if problems:
                 raise KernelError("after Basic_aft: " + "; ".join(problems[:5]))
+
+    def smooth(self, int first_movable, int passes):
+        """Smooth the vertices first_movable.. (those Basic_aft created) for `passes`
+        rounds, each followed by Delaunay flips; returns the number of moves."""
+        cdef int res
+        with nogil:
+            res = smooth(&self.T, first_movable, passes)
+        _raise_for(&self.T, res)
+        return res
 
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,

@@ -54,6 +54,10 @@ cdef struct Aft:
     int32_t* right
     int nleft, nright, lr_cap
     int vis_loc, vis_where
+    # progress: meshed / total area, reported to a Python callable (a borrowed
+    # reference kept alive by the owning Triangulation) every few thousand steps
+    double area_total, area_meshed
+    void* progress
 
 
 cdef int aft_init(Aft* A) noexcept nogil:
@@ -151,6 +155,13 @@ cdef inline bint is_front(Tri* T, int e) noexcept nogil:
 
 # ---------------------------------------------------------------- the subtasks
 
+cdef inline double _tri_area(Tri* T, int t) noexcept nogil:
+    cdef double* a = P(T, T.tv[3 * t])
+    cdef double* b = P(T, T.tv[3 * t + 1])
+    cdef double* c = P(T, T.tv[3 * t + 2])
+    return 0.5 * ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
 cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
     """C = every constrained half-edge of an unmeshed triangle (the domain's CDT has
     been built and carved).  Also counts the triangles for formula (4)."""
@@ -158,11 +169,14 @@ cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
     A.heap_n = 0
     A.n_meshed = 0
     A.n_unmeshed = 0
+    A.area_total = 0.0
+    A.area_meshed = 0.0
     for t in range(T.nt):
         if T.tstate[t] == T_MESHED:
             A.n_meshed += 1
         elif T.tstate[t] == T_UNMESHED:
             A.n_unmeshed += 1
+            A.area_total += _tri_area(T, t)
             for k in range(3):
                 if blocking(T, 3 * t + k):
                     if heap_push(A, T, 3 * t + k):
@@ -440,6 +454,7 @@ cdef int add_triangle(Aft* A, Tri* T, int t) noexcept nogil:
     T.tstate[t] = T_MESHED
     A.n_meshed += 1
     A.n_unmeshed -= 1
+    A.area_meshed += _tri_area(T, t)
     for k in range(3):
         e = 3 * t + k
         f = T.twin[e]
@@ -528,7 +543,7 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
 
 cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
     """Figure 5, compiled: runs without the GIL and takes it back only every few
-    thousand steps to let Ctrl-C through."""
+    thousand steps to let Ctrl-C through and to report progress."""
     cdef int e, res
     cdef int64_t count = 0
     while True:
@@ -544,6 +559,13 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
                 if PyErr_CheckSignals() != 0:
                     PyErr_Clear()
                     return ERR_INTERRUPTED
+                if A.progress != NULL and A.area_total > 0:
+                    try:
+                        (<object> A.progress)(A.area_meshed / A.area_total)
+                    except KeyboardInterrupt:
+                        return ERR_INTERRUPTED
+                    except BaseException:
+                        pass                # a broken progress display must not stop meshing
     if A.n_unmeshed != 0:
         return ERR_INTERNAL
     return 0

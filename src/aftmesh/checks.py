@@ -36,7 +36,7 @@ def _edges(tri: np.ndarray):
 
 def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
                input_segments: np.ndarray | None = None, delaunay: bool = True,
-               area_rtol: float = 1e-9) -> None:
+               boundary_is_segments: bool | None = None, area_rtol: float = 1e-9) -> None:
     """Check every invariant of ``mesh``; raise :class:`MeshCheckError` if any fails.
 
     Parameters
@@ -47,6 +47,9 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         Input edges as coordinate pairs; each must be covered exactly by mesh segments.
     delaunay : bool
         Also check the constrained Delaunay property.
+    boundary_is_segments : bool, optional
+        Require every boundary edge to be a segment (default: when the mesh has
+        segments at all; a CDT of bare points is bounded by its convex hull instead).
     """
     problems: list[str] = []
     P = np.asarray(mesh.points)
@@ -107,7 +110,9 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         seg_keys.add((int(u), int(v)))
         seg_keys.add((int(v), int(u)))
     boundary = ~found.reshape(t, 3)
-    for ti, k in np.argwhere(boundary):
+    if boundary_is_segments is None:
+        boundary_is_segments = len(S) > 0
+    for ti, k in (np.argwhere(boundary) if boundary_is_segments else ()):
         e = (int(a[ti, k]), int(b[ti, k]))
         if e not in seg_keys:
             problems.append(f"boundary edge {e} of triangle {ti} is not a segment")

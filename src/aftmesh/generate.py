@@ -1,6 +1,7 @@
 """``aftmesh.generate``: a quality triangle mesh of a domain by Basic_aft."""
 from __future__ import annotations
 
+import sys
 import time
 
 import numpy as np
@@ -13,11 +14,40 @@ from .domain import to_domain
 from .errors import InvalidDomainError, InvalidOptionError, InvalidSizeError
 from .mesh import Mesh
 from .pslg import build_cdt
-from .sizing import DEFAULT_GRADATION, make_size_field
+from .sizing import DEFAULT_GRADATION, make_size_field, per_region_size
 
 __all__ = ["generate"]
 
 _ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
+
+
+class _ProgressBar:
+    """A one-line bar on standard error, redrawn only when the percentage changes."""
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.last = -1
+
+    def __call__(self, fraction: float) -> None:
+        pct = int(100 * min(max(fraction, 0.0), 1.0))
+        if pct != self.last:
+            self.last = pct
+            filled = pct * 30 // 100
+            self.stream.write(f"\raftmesh [{'#' * filled}{'.' * (30 - filled)}] {pct:3d}%")
+            self.stream.flush()
+
+    def close(self) -> None:
+        if self.last >= 0:
+            self.stream.write("\r" + " " * 48 + "\r")
+            self.stream.flush()
+
+
+def _progress_callback(progress, expected_triangles: int):
+    if callable(progress):
+        return progress
+    if progress is None:
+        progress = sys.stderr.isatty() and expected_triangles > 200_000
+    return _ProgressBar(sys.stderr) if progress else None
 
 
 def _check_options(order, max_triangles, min_area, close_factor):
@@ -39,7 +69,7 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
              min_area: float | None = None, order: str = "shortest", greedy: bool = False,
              swaps: bool = True, split_boundary: bool = True,
              gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
-             strategy: Strategy | None = None) -> Mesh:
+             smooth: int = 3, strategy: Strategy | None = None, progress=None) -> Mesh:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -50,9 +80,10 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         polygons with disjoint interiors (one region each), an (n, 2) coordinate array
         (one ring), a Triangle-style dict (``vertices``, ``segments``, ``holes``,
         ``regions``), or the path of a ``.poly`` file.
-    size : float, callable or None
-        Target edge length: a number, ``f(x, y) -> array`` (called on whole arrays), or
-        None to take it from the lengths of the input edges.
+    size : float, callable, sequence or None
+        Target edge length: a number, ``f(x, y) -> array`` (called on whole arrays), one
+        number per region (with a sequence of polygons as the domain), or None to take
+        it from the lengths of the input edges.
     max_triangles : int, optional
         N_max: the mesh never has more triangles (formula (4) of the paper).
     min_area : float, optional
@@ -76,9 +107,18 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     close_factor : float
         New_is_preferred refuses R when S, or a vertex R would be joined to, is closer
         than ``close_factor * h`` (a constrained edge: half that).
+    smooth : int
+        Rounds of smoothing after the front has closed (0: none): each moves every
+        vertex Basic_aft created to the mean of its neighbours when that keeps its
+        triangles valid, then restores the Delaunay property by edge swaps.  Input
+        vertices never move.  ``info['smoothing_moves']`` counts the moves.
     strategy : Strategy, optional
         Subtasks to plug in (see :class:`aftmesh.aft.Strategy`); the Python loop runs
         then, otherwise the compiled one.
+    progress : bool or callable, optional
+        A progress bar (fraction of the area meshed) on standard error: by default
+        shown only when standard error is a terminal and the mesh is large; True or
+        False to force it; a callable ``f(fraction)`` to receive the fraction instead.
 
     Returns
     -------
@@ -102,19 +142,19 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
     lo = dom.vertices.min(axis=0)
     hi = dom.vertices.max(axis=0)
-    lengths = None
-    if size is None:
-        seg = dom.segments
-        if len(seg) == 0:
-            raise InvalidSizeError("size=None takes the size from the input edges, but there are none")
+    if isinstance(size, (list, tuple, np.ndarray)):
+        if dom.polygons is None:
+            raise InvalidSizeError("a list of sizes needs a list of region polygons as the domain")
+        size = per_region_size(dom.polygons, size)
+    seg = dom.segments
+    if len(seg):
+        # the shortest input edge at each vertex: the size never asks for more there
         L = np.linalg.norm(dom.vertices[seg[:, 1]] - dom.vertices[seg[:, 0]], axis=1)
-        lengths = np.zeros(len(dom.vertices))
-        count = np.zeros(len(dom.vertices))
-        np.add.at(lengths, seg.ravel(), np.repeat(L, 2))
-        np.add.at(count, seg.ravel(), 1)
-        used = count > 0
-        lengths = lengths[used] / count[used]
-        field = make_size_field(None, (lo, hi), dom.vertices[used], lengths, gradation)
+        shortest = np.full(len(dom.vertices), np.inf)
+        np.minimum.at(shortest, seg[:, 0], L)
+        np.minimum.at(shortest, seg[:, 1], L)
+        used = np.isfinite(shortest)
+        field = make_size_field(size, (lo, hi), dom.vertices[used], shortest[used], gradation)
     else:
         field = make_size_field(size, (lo, hi), gradation=gradation)
     if split_boundary:
@@ -153,12 +193,22 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     compiled = strategy is None or strategy.is_builtin
     if compiled:
         kernel.convert_to_frontal_edge_set()
-        kernel.run()
+        bar = _progress_callback(progress, nt_hint)
+        try:
+            kernel.run(progress=bar)
+        finally:
+            if isinstance(bar, _ProgressBar):
+                bar.close()
     else:
         basic_aft(kernel, strategy)
         if kernel.counters()["unmeshed"] != 0:
             raise InvalidOptionError(
                 "the strategy's get_next_edge returned -1 while front edges remained")
+    moves = 0
+    if smooth:
+        if isinstance(smooth, bool) or not isinstance(smooth, (int, np.integer)) or smooth < 0:
+            raise InvalidOptionError(f"smooth must be a number of rounds >= 0, got {smooth!r}")
+        moves = kernel.smooth(len(verts), int(smooth))
     t_aft = time.perf_counter()
     a = kernel.arrays()
     to_out = a["vertex_map"][built.merged]
@@ -170,6 +220,7 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         "cleanup": dom.cleanup,
         "sources": dom.source_names,
         "new_vertices": counters["new_vertices"],
+        "smoothing_moves": moves,
         "compiled_loop": compiled,
         "size_field": field,
         "timing": {"boundary": t_boundary - t_start, "cdt": t_cdt - t_boundary,

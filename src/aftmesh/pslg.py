@@ -131,6 +131,13 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
         if not np.isfinite(reg).all():
             i = int(np.flatnonzero(~np.isfinite(reg).all(axis=1))[0])
             raise InvalidInputError(f"regions[{i}] = {reg[i].tolist()} is not finite")
+        # Mesh.regions holds integer markers; Triangle's regional attributes may be
+        # any number, so refuse rather than silently truncate one
+        frac = (reg[:, 2] != np.rint(reg[:, 2])) | (np.abs(reg[:, 2]) > 2**31 - 1)
+        if frac.any():
+            i = int(np.flatnonzero(frac)[0])
+            raise InvalidInputError(
+                f"regions[{i}] has marker {reg[i, 2]!r}: region markers must be integers")
     kernel = _kernel.Triangulation(pts, nt_hint)
     try:
         merged = kernel.insert_points(brio_order(pts))

@@ -81,6 +81,39 @@ def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     return h
 
 
+def per_region_size(polygons, sizes):
+    """A size callable from one size per region: each region's own value inside it,
+    the largest value outside all of them (the gradation limit then blends the values
+    across interfaces, from the smaller side)."""
+    import shapely
+
+    values = []
+    for k, v in enumerate(sizes):
+        try:
+            v = float(v)
+        except (TypeError, ValueError):
+            raise InvalidSizeError(f"size[{k}] = {v!r} is not a number") from None
+        if not (np.isfinite(v) and v > 0):
+            raise InvalidSizeError(f"size[{k}] = {v!r}: sizes must be finite and positive")
+        values.append(v)
+    if len(values) != len(polygons):
+        raise InvalidSizeError(
+            f"got {len(values)} sizes for {len(polygons)} regions: give one size per region")
+    prepared = list(polygons)
+    for p in prepared:
+        shapely.prepare(p)   # speeds up the repeated point-in-polygon tests
+
+    def size(x, y):
+        x = np.asarray(x, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        out = np.full(np.broadcast(x, y).shape, max(values))
+        for poly, v in zip(prepared, values):
+            inside = shapely.intersects_xy(poly, x, y)
+            out[inside] = np.minimum(out[inside], v)
+        return out
+    return size
+
+
 def limit_gradation(h: np.ndarray, dx: float, dy: float, gradation: float) -> np.ndarray:
     """Smallest field <= h with h(x) <= h(y) + (gradation - 1) * |x - y| between grid
     nodes (distances along rows and columns, repeated so diagonals are covered)."""
@@ -122,48 +155,71 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
                     gradation: float = DEFAULT_GRADATION) -> SizeField:
     """Turn a size specification into a :class:`SizeField` over ``bounds``.
 
+    The field is the smaller of the user's size and the sizes the boundary itself asks
+    for: an input edge shorter than the user's size is kept, so the size near its ends
+    is that edge's length, growing away from it at the gradation rate.  Without that,
+    a triangle built on a short edge would have to be either a needle or much smaller
+    than its neighbours.
+
     Parameters
     ----------
     size : float, callable or None
+        None: the boundary's edge lengths alone.
     bounds : ((xmin, ymin), (xmax, ymax))
-    boundary_points, boundary_lengths : arrays, for ``size=None``: the input vertices and
-        the mean length of the input edges at each.
+    boundary_points, boundary_lengths : arrays
+        The input vertices and the length of the shortest input edge at each.
     gradation : float >= 1
-        Largest growth factor of the size per its own length; 1 means no limit.
+        Largest growth of the size per unit of length, as a factor: h may grow by
+        (gradation - 1) times the distance; 1 means no limit.
     """
     if gradation is None or not np.isfinite(gradation) or gradation < 1.0:
         raise InvalidSizeError(f"gradation must be a finite number >= 1, got {gradation!r}")
+    constant = None
     if size is not None and not callable(size):
         try:
-            value = float(size)
+            constant = float(size)
         except (TypeError, ValueError):
             raise InvalidSizeError(
                 f"size must be a number, a callable f(x, y) or None, got {size!r}") from None
-        if not (np.isfinite(value) and value > 0):
+        if not (np.isfinite(constant) and constant > 0):
             raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
-        return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[value]]))
+    have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
+    if constant is not None and (not have_boundary
+                                 or float(np.min(boundary_lengths)) >= 0.8 * constant):
+        # the boundary asks for nothing smaller: a constant needs no grid
+        return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[constant]]))
+    if size is None and not have_boundary:
+        raise InvalidSizeError("size=None takes the size from the input edges, but there are none")
     (xmin, ymin), (xmax, ymax) = bounds
     span = max(xmax - xmin, ymax - ymin)
     pad = 0.02 * span
     bounds = ((xmin - pad, ymin - pad), (xmax + pad, ymax + pad))
+    spacing = span / 64
+    if have_boundary:
+        spacing = min(spacing, 0.5 * float(np.min(boundary_lengths)))
     if callable(size):
         # a coarse look first, to pick a grid spacing fine enough for the smallest size
         x0, y0, dx, dy, X, Y = _grid(bounds, span / 64)
         h0 = _evaluate(size, X, Y)
-        x0, y0, dx, dy, X, Y = _grid(bounds, 0.5 * float(h0.min()))
+        spacing = min(spacing, 0.5 * float(h0.min()))
+    x0, y0, dx, dy, X, Y = _grid(bounds, spacing)
+    if callable(size):
         h = _evaluate(size, X, Y)
+    elif constant is not None:
+        h = np.full(X.shape, constant)
     else:
+        h = np.full(X.shape, np.inf)
+    if have_boundary:
         pts = np.asarray(boundary_points, dtype=np.float64)
         lengths = np.asarray(boundary_lengths, dtype=np.float64)
-        x0, y0, dx, dy, X, Y = _grid(bounds, 0.5 * float(lengths.min()))
-        h = np.full(X.shape, np.inf)
-        # seed each boundary vertex's size at its nearest grid node, then spread
-        i = np.clip(np.rint((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 1)
-        j = np.clip(np.rint((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 1)
-        np.minimum.at(h, (j, i), lengths)
-        if gradation <= 1.0:
-            gradation = DEFAULT_GRADATION
-    h = limit_gradation(h, dx, dy, gradation)
+        # each boundary vertex asks for its edge length at the grid nodes around it
+        i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
+        j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)
+        for di in (0, 1):
+            for dj in (0, 1):
+                np.minimum.at(h, (j + dj, i + di), lengths)
+    h = limit_gradation(h, dx, dy, gradation if gradation > 1.0 else DEFAULT_GRADATION
+                        if not np.isfinite(h).all() else gradation)
     if not np.isfinite(h).all():
         raise InvalidSizeError("could not derive a size from the boundary")
     return SizeField(float(x0), float(y0), float(dx), float(dy), np.ascontiguousarray(h))

@@ -1,0 +1,205 @@
+"""Run the measurements: one subprocess per (mesher, case), per CDT memory probe and
+one for the CDT speed comparison; collect what they print."""
+from __future__ import annotations
+
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from .cases import build_case
+from .meshers import MESHERS, REFERENCE, mesher_available
+
+ROOT = Path(__file__).resolve().parent.parent
+MARK = "@@RESULT "
+
+
+def _env() -> dict:
+    env = dict(os.environ)
+    parts = [str(ROOT), str(ROOT / "src")]
+    if env.get("PYTHONPATH"):
+        parts.append(env["PYTHONPATH"])
+    env["PYTHONPATH"] = os.pathsep.join(parts)
+    env.setdefault("OMP_NUM_THREADS", "1")
+    return env
+
+
+def run_job(job: dict, timeout: float) -> dict:
+    """Run one job in a fresh interpreter; a failure becomes ``{"error": ...}``.
+    A failed import of the compiled kernel (it may be being rebuilt) is retried."""
+    for attempt in range(3):
+        t0 = time.perf_counter()
+        try:
+            proc = subprocess.run([sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
+                                  cwd=ROOT, env=_env(), capture_output=True, text=True,
+                                  timeout=timeout)
+        except subprocess.TimeoutExpired:
+            return {"error": f"timeout after {timeout:.0f} s"}
+        wall = time.perf_counter() - t0
+        lines = [ln for ln in proc.stdout.splitlines() if ln.startswith(MARK)]
+        if lines:
+            res = json.loads(lines[-1][len(MARK):])
+        else:
+            tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+            res = {"error": f"worker exit {proc.returncode}: {tail}"}
+        res["wall"] = wall
+        err = res.get("error", "")
+        if "_kernel" in err and ("Import" in err or "undefined symbol" in err) and attempt < 2:
+            time.sleep(5)          # the kernel is being swapped: try again
+            continue
+        return res
+    return res
+
+
+def _median(xs):
+    return statistics.median(xs) if xs else None
+
+
+# ----------------------------------------------------------------------- meshing
+
+def reference_area(case) -> float | None:
+    """Area of the faces that are not holes (what every mesher should cover)."""
+    try:
+        from .meshers import _faces
+        faces, _, _ = _faces(case)
+        return float(sum(poly.area for poly, _, _ in faces))
+    except Exception:
+        return None
+
+
+def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
+                   gmsh_limit: float, log=print) -> dict:
+    rows = []
+    cases_meta = {}
+    for cname in case_names:
+        try:
+            case = build_case(cname)
+        except Exception as exc:
+            log(f"  {cname}: cannot build: {exc}")
+            rows.append({"case": cname, "mesher": "-", "error": f"case: {exc}"})
+            continue
+        cases_meta[cname] = {"description": case.description, "vertices": len(case.vertices),
+                             "segments": len(case.segments), "holes": len(case.holes),
+                             "notes": case.notes, "area": reference_area(case)}
+        aft_triangles = None
+        for mname in mesher_names:
+            row = {"case": cname, "mesher": mname}
+            why = mesher_available(mname)
+            if why:
+                row["error"] = f"not available ({why})"
+                rows.append(row)
+                continue
+            if (mname.startswith("gmsh") and aft_triangles is not None
+                    and aft_triangles > gmsh_limit):
+                row["skipped"] = (f"skipped: about {aft_triangles:.2g} triangles > gmsh limit "
+                                  f"{gmsh_limit:.2g} (--gmsh-limit)")
+                rows.append(row)
+                log(f"  {cname:18s} {mname:14s} {row['skipped']}")
+                continue
+            job = {"kind": "mesh", "case": cname, "mesher": mname, "repeat": repeat,
+                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 1.5 if quick else 60.0,
+                   "edges": True}
+            res = run_job(job, timeout=120 if quick else 1200)
+            row.update(res)
+            if "times" in res:
+                row["median"] = _median(res["times"])
+                row["triangles"] = res["stats"]["triangles"]
+                if mname == "aft":
+                    aft_triangles = row["triangles"]
+                log(f"  {cname:18s} {mname:14s} {row['triangles']:>9d} tri  "
+                    f"{row['median']:.4f} s  ({len(res['times'])} runs)")
+            else:
+                log(f"  {cname:18s} {mname:14s} ERROR {res.get('error')}")
+            rows.append(row)
+        ref = next((r for r in rows if r["case"] == cname and r["mesher"] == REFERENCE
+                    and r.get("median")), None)
+        mine = [r for r in rows if r["case"] == cname and r.get("median")]
+        for r in mine:
+            r["tri_per_s"] = r["triangles"] / r["median"]
+        for r in mine:
+            if ref:
+                r["time_ratio"] = r["median"] / ref["median"]
+                r["rate_ratio"] = r["tri_per_s"] / ref["tri_per_s"]
+    return {"rows": rows, "cases": cases_meta, "meshers": {m: MESHERS[m] for m in mesher_names},
+            "reference": REFERENCE}
+
+
+# ----------------------------------------------------------------------- CDT
+
+def run_cdt_suite(*, quick: bool, repeat: int, log=print) -> dict:
+    tools = ["aft", "tri", "scipy"]
+    sizes = [1e4, 1e5, 1e6]
+    job = {"kind": "cdt-speed", "sizes": sizes, "repeat": repeat,
+           "repeat_big": 2 if quick else max(3, min(repeat, 5)),
+           "constrained": True, "tools": tools}
+    log("  CDT speed (one process) ...")
+    res = run_job(job, timeout=300 if quick else 1800)
+    rows = res.get("rows", [])
+    if "error" in res:
+        rows = [{"input": "all", "tool": "-", "error": res["error"]}]
+    for r in rows:
+        if "times" in r:
+            r["median"] = _median(r["times"])
+    for r in rows:
+        ref = next((x for x in rows if x["input"] == r["input"] and x["tool"] == "tri"
+                    and x.get("median")), None)
+        if r.get("median") and ref:
+            r["time_ratio"] = r["median"] / ref["median"]
+        if r.get("median"):
+            log(f"  {r['input']:32s} {r['tool']:6s} {r['median']:.4f} s  {r['triangles']} tri")
+    mem = []
+    for tool in ["aft", "tri"]:
+        log(f"  CDT memory, {tool}, 1e6 points ...")
+        m = run_job({"kind": "cdt-mem", "tool": tool, "n": 1_000_000}, timeout=600)
+        m.setdefault("tool", tool)
+        mem.append(m)
+    return {"rows": rows, "memory": mem}
+
+
+# ----------------------------------------------------------------------- scaling
+
+SCALING_H_FULL = [0.015, 0.008, 0.0045, 0.0025, 0.0015, 0.001, 0.0007, 0.0005]
+SCALING_H_QUICK = [0.015, 0.008, 0.0045, 0.0025, 0.0015]
+SCALING_MESHERS = ["aft", REFERENCE]
+
+
+def fit_exponent(n, t):
+    """Least-squares slope of log t against log n."""
+    import numpy as np
+    n = np.log(np.asarray(n, dtype=float))
+    t = np.log(np.asarray(t, dtype=float))
+    if len(n) < 2:
+        return None
+    return float(np.polyfit(n, t, 1)[0])
+
+
+def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
+    hs = SCALING_H_QUICK if quick else SCALING_H_FULL
+    rows = []
+    for h in hs:
+        for mname in SCALING_MESHERS:
+            job = {"kind": "mesh", "case": f"square-{h:g}", "mesher": mname,
+                   "repeat": repeat if h > 0.002 else 3, "min_repeat": 1,
+                   "budget": 1.0 if quick else 20.0, "edges": False}
+            res = run_job(job, timeout=300 if quick else 1800)
+            row = {"h": h, "mesher": mname, **res}
+            if "times" in res:
+                row["median"] = _median(res["times"])
+                row["triangles"] = res["stats"]["triangles"]
+                log(f"  h={h:<8g} {mname:10s} {row['triangles']:>9d} tri  {row['median']:.4f} s"
+                    f"  {res['mem_mib']:.0f} MiB")
+            else:
+                log(f"  h={h:<8g} {mname:10s} ERROR {res.get('error')}")
+            rows.append(row)
+    fits = {}
+    for mname in SCALING_MESHERS:
+        ok = [r for r in rows if r["mesher"] == mname and r.get("median")]
+        big = [r for r in ok if r["triangles"] >= 1e5]
+        fits[mname] = {
+            "all": fit_exponent([r["triangles"] for r in ok], [r["median"] for r in ok]),
+            "from_1e5": fit_exponent([r["triangles"] for r in big], [r["median"] for r in big]),
+        }
+    return {"rows": rows, "fits": fits}

@@ -1,0 +1,192 @@
+"""One measurement in a fresh process: ``python -m benchmarks.worker '<json job>'``.
+
+Prints one line ``@@RESULT <json>`` at the end.  Jobs:
+
+* ``{"kind": "mesh", "case", "mesher", "repeat", "min_repeat", "budget", "edges"}``
+* ``{"kind": "cdt-speed", "sizes", "repeat", "constrained", "tools"}``
+* ``{"kind": "cdt-mem", "tool", "n"}``
+"""
+from __future__ import annotations
+
+import gc
+import json
+import sys
+import time
+import traceback
+
+import numpy as np
+
+MARK = "@@RESULT "
+
+
+def _emit(obj) -> None:
+    sys.stdout.write(MARK + json.dumps(obj) + "\n")
+    sys.stdout.flush()
+
+
+# ----------------------------------------------------------------------- meshing
+
+def mesh_job(job: dict) -> dict:
+    from .cases import build_case, square
+    from .measure import MemoryProbe, quality_stats
+    from .meshers import prepare
+
+    case = build_case(job["case"])
+    name = job["mesher"]
+    # warm-up on a tiny square: loads lazily imported code, initialises Gmsh
+    tiny = prepare(name, square(0.1))
+    tiny.result(tiny.run())
+    del tiny
+
+    runner = prepare(name, case)
+    probe = MemoryProbe()
+    probe.start()
+    t0 = time.perf_counter()
+    raw = runner.run()
+    times = [time.perf_counter() - t0]
+    mem = probe.stop_mib()
+    out = runner.result(raw)
+    target = case.target if job.get("edges", True) else None
+    stats = quality_stats(out.points, out.triangles, target)
+    stats["segments_out"] = out.n_segments
+    stats["segments_in"] = int(len(case.segments))
+    passes = runner.passes
+    del raw, out
+    started = time.perf_counter()
+    while len(times) < job["repeat"]:
+        if len(times) >= job["min_repeat"] and time.perf_counter() - started > job["budget"]:
+            break
+        runner.reset()
+        gc.collect()
+        t0 = time.perf_counter()
+        raw = runner.run()
+        times.append(time.perf_counter() - t0)
+        del raw
+    runner.close()
+    return {"times": times, "mem_mib": mem, "mem_method": probe.method, "stats": stats,
+            "passes": passes}
+
+
+# ----------------------------------------------------------------------- CDT
+
+def random_points(n: int, seed: int = 12345) -> np.ndarray:
+    return np.random.default_rng(seed).random((n, 2))
+
+
+def constrained_input(n_points: int = 100_000, n_segments: int = 10_000, seed: int = 7):
+    """Points on a jittered grid (jitter < 1/4 of the spacing) and random segments
+    between grid neighbours: two such segments either share an end or are apart, so
+    none cross (checked anyway).  A square ring of 4 segments encloses everything."""
+    import shapely
+
+    rng = np.random.default_rng(seed)
+    m = int(round(np.sqrt(n_points)))
+    i, j = np.meshgrid(np.arange(m), np.arange(m), indexing="ij")
+    pts = np.column_stack([(i.ravel() + 0.5) / m, (j.ravel() + 0.5) / m])
+    pts += rng.uniform(-0.2 / m, 0.2 / m, pts.shape)
+    idx = (i * m + j).ravel()
+    right = np.column_stack([idx[i.ravel() < m - 1], idx[i.ravel() < m - 1] + m])
+    up = np.column_stack([idx[j.ravel() < m - 1], idx[j.ravel() < m - 1] + 1])
+    cand = np.concatenate([right, up])
+    segs = cand[rng.choice(len(cand), n_segments, replace=False)]
+    lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
+    tree = shapely.STRtree(lines)
+    a, b = tree.query(lines, predicate="crosses")
+    if len(a):
+        raise RuntimeError(f"{len(a) // 2} constraint segments cross")
+    corners = np.array([[-0.01, -0.01], [1.01, -0.01], [1.01, 1.01], [-0.01, 1.01]])
+    n = len(pts)
+    box = np.array([[n, n + 1], [n + 1, n + 2], [n + 2, n + 3], [n + 3, n]])
+    return np.concatenate([pts, corners]), np.concatenate([segs, box]).astype(np.int32)
+
+
+def _cdt_call(tool: str, pts, segs=None):
+    """A callable doing one triangulation and returning its triangle count."""
+    if tool == "aft":
+        import aftmesh
+        if segs is None:
+            return lambda: aftmesh.cdt(pts).n_triangles
+        return lambda: aftmesh.cdt(pts, segs).n_triangles
+    if tool == "tri":
+        import triangle
+        if segs is None:
+            d = {"vertices": pts}
+            return lambda: len(triangle.triangulate(d, "")["triangles"])
+        d = {"vertices": pts, "segments": segs}
+        return lambda: len(triangle.triangulate(d, "p")["triangles"])
+    if tool == "scipy":
+        from scipy.spatial import Delaunay
+        return lambda: len(Delaunay(pts).simplices)   # unconstrained, even with segments
+    raise KeyError(tool)
+
+
+def cdt_speed_job(job: dict) -> dict:
+    tools = job["tools"]
+    warm = random_points(1000, seed=1)
+    for tool in tools:
+        _cdt_call(tool, warm)()
+    rows = []
+    inputs = [(f"{n:.0e} random points", random_points(int(n)), None) for n in job["sizes"]]
+    if job.get("constrained"):
+        p, s = constrained_input()
+        inputs.append((f"{len(p):.0e} points + {len(s) - 4} segments", p, s))
+    for label, pts, segs in inputs:
+        for tool in tools:
+            row = {"input": label, "tool": tool, "n_points": int(len(pts)),
+                   "n_segments": 0 if segs is None else int(len(segs))}
+            try:
+                call = _cdt_call(tool, pts, segs)
+                times, ntri = [], None
+                for _ in range(job["repeat"] if len(pts) < 500_000 else job["repeat_big"]):
+                    gc.collect()
+                    t0 = time.perf_counter()
+                    ntri = call()
+                    times.append(time.perf_counter() - t0)
+                row.update(times=times, triangles=int(ntri))
+            except Exception as exc:
+                row["error"] = f"{type(exc).__name__}: {exc}"
+            rows.append(row)
+    return {"rows": rows}
+
+
+def cdt_mem_job(job: dict) -> dict:
+    from .measure import MemoryProbe
+
+    tool = job["tool"]
+    _cdt_call(tool, random_points(1000, seed=1))()
+    pts = random_points(int(job["n"]))
+    call = _cdt_call(tool, pts)
+    probe = MemoryProbe()
+    probe.start()
+    t0 = time.perf_counter()
+    ntri = call()
+    t = time.perf_counter() - t0
+    mem = probe.stop_mib()
+    return {"tool": tool, "n": int(job["n"]), "triangles": int(ntri), "mem_mib": mem,
+            "time": t, "bytes_per_triangle": mem * 1024 * 1024 / max(ntri, 1),
+            "mem_method": probe.method}
+
+
+def main(argv=None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    job = json.loads(argv[0])
+    try:
+        kind = job["kind"]
+        if kind == "mesh":
+            res = mesh_job(job)
+        elif kind == "cdt-speed":
+            res = cdt_speed_job(job)
+        elif kind == "cdt-mem":
+            res = cdt_mem_job(job)
+        else:
+            raise KeyError(f"unknown job kind {kind!r}")
+    except Exception as exc:
+        tb = traceback.format_exc(limit=4)
+        _emit({"error": f"{type(exc).__name__}: {exc}".strip(), "traceback": tb})
+        return 0
+    _emit(res)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,4 @@
+"""``python -m aftmesh``: the same as the ``aftmesh`` command (see :mod:`aftmesh.cli`)."""
+from .cli import main
+
+raise SystemExit(main())
