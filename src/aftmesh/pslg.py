@@ -137,7 +137,7 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
         if frac.any():
             i = int(np.flatnonzero(frac)[0])
             raise InvalidInputError(
-                f"regions[{i}] has marker {reg[i, 2]!r}: region markers must be integers")
+                f"regions[{i}] has marker {float(reg[i, 2])!r}: region markers must be integers")
     kernel = _kernel.Triangulation(pts, nt_hint)
     try:
         merged = kernel.insert_points(brio_order(pts))
