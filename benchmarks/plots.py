@@ -22,8 +22,8 @@ def _hist_axes(ax, rows, title):
         counts = np.asarray(r["stats"]["rr_hist"], dtype=float)
         if counts.sum() == 0:
             continue
-        ax.step(edges[:-1], counts / counts.sum(), where="post",
-                label=MESHERS.get(r["mesher"], (r["mesher"],))[0])
+        ax.stairs(counts / counts.sum(), edges,
+                  label=MESHERS.get(r["mesher"], (r["mesher"],))[0])
     ax.set_yscale("log")
     ax.set_xlabel("radius ratio 2 r_in / r_circ")
     ax.set_ylabel("fraction of triangles")
@@ -34,6 +34,8 @@ def _hist_axes(ax, rows, title):
 def mesh_histograms(mesh: dict, out: Path) -> list[Path]:
     plt = _plt()
     written = []
+    for stale in out.glob("hist_*.png"):
+        stale.unlink()
     for cname in dict.fromkeys(r["case"] for r in mesh["rows"]):
         rows = [r for r in mesh["rows"] if r["case"] == cname and "stats" in r
                 and r["mesher"] not in ("aft-greedy", "tri-p")]

@@ -113,6 +113,30 @@ def mesh_tables(mesh: dict) -> list[str]:
             out.append(f"- **check**: {fl}")
         if flags:
             out.append("")
+    out += internal_table(mesh)
+    return out
+
+
+def internal_table(mesh: dict) -> list[str]:
+    """aftmesh's own split of its time (median over the runs of Mesh.info['timing'])."""
+    rows = [r for r in mesh["rows"] if r.get("internal_timing")]
+    if not rows:
+        return []
+    hdr = ("| case | mesher | domain + size field + boundary | CDT | Basic_aft | "
+           "arrays + markers + Mesh | total in generate | wall (median) |")
+    out = ["#### aftmesh: where the time goes", "",
+           "Median of `Mesh.info['timing']` over the runs; the first column is everything "
+           "before the CDT (input checks, the size field with its gradation limit, boundary "
+           "splitting); 'arrays + markers + Mesh' is what follows Basic_aft (output arrays, "
+           "segment markers, the Mesh object).", "", hdr, _rule(hdr)]
+    for r in rows:
+        t = r["internal_timing"]
+        parts = [t.get(k) for k in ("boundary", "cdt", "basic_aft", "total")]
+        tail = parts[3] - sum(parts[:3]) if None not in parts else None
+        out.append(f"| {r['case']} | {_label(r['mesher'])} | {_t(parts[0])} | "
+                   f"{_t(parts[1])} | {_t(parts[2])} | {_t(tail)} | {_t(parts[3])} | "
+                   f"{_t(r.get('median'))} |")
+    out.append("")
     return out
 
 

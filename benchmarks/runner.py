@@ -100,7 +100,7 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
                 log(f"  {cname:18s} {mname:14s} {row['skipped']}")
                 continue
             job = {"kind": "mesh", "case": cname, "mesher": mname, "repeat": repeat,
-                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 1.5 if quick else 60.0,
+                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 0.5 if quick else 60.0,
                    "edges": True}
             res = run_job(job, timeout=120 if quick else 1200)
             row.update(res)
