@@ -605,7 +605,8 @@ cdef class Triangulation:
 
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,
-                    new_vertices=self.A.n_new, steps=self.A.n_steps)
+                    new_vertices=self.A.n_new, steps=self.A.n_steps,
+                    forced_edges=self.A.n_forced)
 
     def _check_edge(self, int e):
         if not 0 <= e < 3 * self.T.nt or self.T.tstate[e // 3] == T_FREE:

@@ -49,6 +49,7 @@ cdef struct Aft:
     int64_t n_unmeshed      # triangles of the unmeshed CDT
     int64_t n_new           # vertices created by Update_internal
     int64_t n_steps         # passes through the while loop
+    int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
     # Check_visible's output: crossed edges of the line of sight, and where R lies
     int32_t* left
     int32_t* right
@@ -498,6 +499,7 @@ cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
     if f < 0:
         return ERR_INTERNAL
     if T.tv[prv(f)] != v:
+        A.n_forced += 1
         res = insert_segment(T, a, v, E_FIXED)
         if res < 0:
             return res

@@ -220,6 +220,9 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         "cleanup": dom.cleanup,
         "sources": dom.source_names,
         "new_vertices": counters["new_vertices"],
+        # Update_internal calls where T(E, R) was not already a CDT triangle after
+        # inserting R, so F and G were inserted by retriangulation (Lemma 3.1 says 0)
+        "forced_edges": counters["forced_edges"],
         "smoothing_moves": moves,
         "compiled_loop": compiled,
         "size_field": field,
