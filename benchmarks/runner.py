@@ -133,7 +133,7 @@ def run_cdt_suite(*, quick: bool, repeat: int, log=print) -> dict:
     tools = ["aft", "tri", "scipy"]
     sizes = [1e4, 1e5, 1e6]
     job = {"kind": "cdt-speed", "sizes": sizes, "repeat": repeat,
-           "repeat_big": 2 if quick else max(3, min(repeat, 5)),
+           "repeat_big": 1 if quick else max(3, min(repeat, 5)),
            "constrained": True, "tools": tools}
     log("  CDT speed (one process) ...")
     res = run_job(job, timeout=300 if quick else 1800)

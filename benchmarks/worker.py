@@ -133,16 +133,25 @@ def _cdt_call(tool: str, pts, segs=None):
     raise KeyError(tool)
 
 
+def _count(n) -> str:
+    n = float(n)
+    if n >= 1e6:
+        return f"{n / 1e6:.3g}M"
+    if n >= 1e3:
+        return f"{n / 1e3:.3g}k"
+    return f"{n:.0f}"
+
+
 def cdt_speed_job(job: dict) -> dict:
     tools = job["tools"]
     warm = random_points(1000, seed=1)
     for tool in tools:
         _cdt_call(tool, warm)()
     rows = []
-    inputs = [(f"{n:.0e} random points", random_points(int(n)), None) for n in job["sizes"]]
+    inputs = [(f"{_count(n)} random points", random_points(int(n)), None) for n in job["sizes"]]
     if job.get("constrained"):
         p, s = constrained_input()
-        inputs.append((f"{len(p):.0e} points + {len(s) - 4} segments", p, s))
+        inputs.append((f"{_count(len(p))} grid points + {_count(len(s) - 4)} segments", p, s))
     for label, pts, segs in inputs:
         for tool in tools:
             row = {"input": label, "tool": tool, "n_points": int(len(pts)),

@@ -14,6 +14,7 @@ from fractions import Fraction
 
 import numpy as np
 import shapely
+import shapely.affinity
 import triangle
 from hypothesis import assume
 from hypothesis import strategies as st
@@ -175,11 +176,45 @@ def annulus():
     return shapely_case("annulus", outer.difference(inner), 0.2)
 
 
+def far_from_origin(offset=1e6):
+    """The L-shape translated far away: coordinates with few bits left for detail."""
+    L = Polygon([(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)])
+    return shapely_case(f"L+{offset:g}", shapely.affinity.translate(L, offset, offset), 0.25)
+
+
+def tiny_annulus(scale=1e-6):
+    a = annulus()
+    geom = shapely.affinity.scale(a.domain, scale, scale, origin=(0, 0))
+    return shapely_case(f"annulus*{scale:g}", geom, a.size * scale)
+
+
+def narrow_slot():
+    """A slot much narrower than the size cut into a rectangle."""
+    ring = [(0, 0), (3, 0), (3, 2), (1.55, 2), (1.55, 0.5), (1.45, 0.5), (1.45, 2), (0, 2)]
+    return shapely_case("slot", Polygon(ring), 0.3)
+
+
+def spiral():
+    th = np.linspace(0, 4 * np.pi, 80)
+    inner, outer = 1 + th, 1.5 + th
+    ring = np.r_[np.c_[inner * np.cos(th), inner * np.sin(th)],
+                 np.c_[outer * np.cos(th), outer * np.sin(th)][::-1]]
+    poly = Polygon(ring)
+    assert poly.is_valid
+    return shapely_case("spiral", poly, 0.3)
+
+
+def sliver():
+    """A needle triangle, 1000 times longer than high."""
+    return shapely_case("sliver", Polygon([(0, 0), (10, 0), (10, 0.01)]), 1.0)
+
+
 def shapely_cases() -> list[Case]:
     return [square(), regular_polygon(), l_shape(), comb(), thin_channel(), serpentine(),
             many_holes(3, "square"), many_holes(4, "circle"), hole_touching_boundary(True),
             hole_touching_boundary(False), holes_touching_each_other(),
-            corner_touching_parts(), vertex_on_edge_parts(), annulus()]
+            corner_touching_parts(), vertex_on_edge_parts(), annulus(), far_from_origin(),
+            tiny_annulus(), narrow_slot(), spiral(), sliver()]
 
 
 # Triangle's sample files that describe closed domains (box.poly has an unclosed

@@ -143,7 +143,7 @@ def output_to_input(mesh, n_in):
     return back
 
 
-def run_triangle(V, S, H, R):
+def run_triangle(V, S, H, R, convex=False):
     """Triangle on the same PSLG ('p', plus 'c' without segments, 'A' with regions).
 
     Triangle can crash (segfault) on duplicate vertices referenced by segments, so it
@@ -155,11 +155,11 @@ def run_triangle(V, S, H, R):
     new_index = np.full(len(V), -1, dtype=np.int64)
     new_index[keep] = np.arange(len(keep))
     data = dict(vertices=V[keep])
-    opts = "p"
+    opts = "pc" if convex else "p"
     if len(S):
         data["segments"] = new_index[canon[np.asarray(S, dtype=np.int64)]].astype(np.int32)
         data["segment_markers"] = (np.arange(len(S)) + 2).astype(np.int32).reshape(-1, 1)
-    else:
+    elif not convex:
         # without segments our domain is the convex hull: Triangle's -c
         opts += "c"
     if len(H):
@@ -815,18 +815,18 @@ def test_fuzz_crossing_reports_agree_with_triangle(graph):
         aftmesh.cdt(V, S)
     except CrossingSegmentsError as err:
         # Triangle must need an intersection vertex for the same input
-        ref = run_triangle(V, S, [], [])
+        ref = run_triangle(V, S, [], [], convex=True)
         assert ref["added_vertices"] > 0, f"Triangle sees no crossing: {err}"
         assert len(err.segments) == 2
         for k in err.segments:
             assert f"segments[{k}]" in str(err)
         # the two named segments do cross: they alone make Triangle add a vertex
-        alone = run_triangle(V, [S[k] for k in err.segments], [], [])
+        alone = run_triangle(V, [S[k] for k in err.segments], [], [], convex=True)
         assert alone["added_vertices"] > 0, f"the two named segments do not cross: {err}"
     except InvalidDomainError:
         pass
     else:
-        ref = run_triangle(V, S, [], [])
+        ref = run_triangle(V, S, [], [], convex=True)
         assert ref["added_vertices"] == 0, "Triangle had to add a crossing vertex"
 
 

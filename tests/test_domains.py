@@ -8,6 +8,7 @@ import re
 import numpy as np
 import pytest
 import shapely
+import triangle
 from hypothesis import given
 from hypothesis import strategies as st
 from shapely.geometry import (GeometryCollection, LineString, MultiPolygon, Point,
@@ -20,9 +21,9 @@ import domain_cases as dc
 
 
 def valid(mesh, area, *, edges=None, delaunay=True):
-    """check_mesh (its own empty-circle test is not exact yet, see test_generate) plus
-    exact orientation, formula (6), and the CDT property against Triangle."""
-    check_mesh(mesh, domain_area=area, input_segments=edges, delaunay=False)
+    """check_mesh plus exact orientation, formula (6), and the CDT property against
+    Triangle."""
+    check_mesh(mesh, domain_area=area, input_segments=edges, delaunay=delaunay)
     assert (dc.orient_signs(np.asarray(mesh.points), np.asarray(mesh.triangles)) > 0).all()
     for T, Eb, Vi, m in count_formula(mesh):
         assert T == Eb + 2 * Vi + 2 * (m - 1)
@@ -112,6 +113,44 @@ def test_geometry_collection_line_splits_domain():
     assert ((x.max(axis=1) <= 1) | (x.min(axis=1) >= 1)).all()
 
 
+@pytest.mark.parametrize("line", [[(1.0, 0.0), (1.0, 0.6)], [(0.5, 0.5), (1.5, 0.5)],
+                                  [(0.3, 0.2), (1.6, 0.7)]],
+                         ids=["from-boundary", "interior", "slanted"])
+def test_geometry_collection_crack(line):
+    """A constraint line with a free end (a crack): a segment with triangles on both
+    sides, its free end a vertex."""
+    gc = GeometryCollection([box(0, 0, 2, 1), LineString(line)])
+    mesh = valid(aftmesh.generate(gc, 0.1), 2.0)
+    assert covered_by_segments(mesh, *line)
+    assert tuple(map(float, line[1])) in dc.coordinate_keys(mesh.points)
+    rows = count_formula(mesh)
+    assert len(rows) == 1 and rows[0][3] == 0
+    # every piece of the crack is an interior edge: two triangles on it
+    P = np.asarray(mesh.points)
+    S = np.asarray(mesh.segments)
+    on = dc.points_on_edges(P[S[:, 0]], np.array([line]), 1e-9) & \
+        dc.points_on_edges(P[S[:, 1]], np.array([line]), 1e-9)
+    T = np.asarray(mesh.triangles)
+    e = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)
+    uniq, counts = np.unique(e, axis=0, return_counts=True)
+    twice = {tuple(x) for x in uniq[counts == 2].tolist()}
+    assert on.sum() >= 2
+    assert all(tuple(sorted(x)) in twice for x in S[on].tolist())
+
+
+def test_inclusion_regions():
+    """The paper's Figure 2: an annular region around a core region."""
+    outer, core = box(0, 0, 4, 3), box(1, 1, 3, 2)
+    ring = outer.difference(core)
+    mesh = valid(aftmesh.generate([ring, core], 0.25), 12.0)
+    assert region_areas(mesh) == pytest.approx({0: 10.0, 1: 2.0}, rel=1e-12)
+    shared = _shared_edge_vertices(
+        mesh, lambda p: (p[0] in (1.0, 3.0) and 1 <= p[1] <= 2) or
+        (p[1] in (1.0, 2.0) and 1 <= p[0] <= 3))
+    assert shared[0] == shared[1] and len(shared[0]) >= 12
+    assert len(count_formula(mesh)) == 1
+
+
 def _shared_edge_vertices(mesh, on_edge):
     """The vertices on the shared edge used by the triangles of each region."""
     P = np.asarray(mesh.points)
@@ -183,6 +222,58 @@ def test_repeated_vertices_are_cleaned_up():
         assert len(np.unique(mesh.points, axis=0)) == len(mesh.points)
 
 
+def shortest_edge(mesh) -> float:
+    P = np.asarray(mesh.points)
+    e = mesh.edges
+    return float(np.linalg.norm(P[e[:, 1]] - P[e[:, 0]], axis=1).min())
+
+
+# A vertex of one ring lying inside an edge of another ring (not at one of its
+# vertices) does not cut that edge before it is discretized: a piece end lands next to
+# the vertex (1e-16 away when the size divides the edge evenly, a small fraction of the
+# size otherwise), and the CDT then splits the piece there: a needle triangle.
+def test_regression_hole_vertex_inside_exterior_edge():
+    poly = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(2, 0), (3, 2), (1, 2)]])
+    mesh = valid(aftmesh.generate(poly, 0.5), poly.area)
+    assert shortest_edge(mesh) > 0.1          # 4.4e-16: (1.9999999999999996, 0) and (2, 0)
+    assert mesh.quality()["min_angle"] > 5    # 0.0
+
+
+def test_regression_multipolygon_vertex_inside_edge():
+    geom = MultiPolygon([box(0, 0, 2, 1), Polygon([(1, 1), (1.5, 2), (0.5, 2)])])
+    mesh = valid(aftmesh.generate(geom, 0.25), geom.area)
+    assert shortest_edge(mesh) > 0.05
+
+
+def test_regression_constraint_end_on_boundary_edge():
+    gc = GeometryCollection([box(0, 0, 2, 1), LineString([(1, 0), (1, 0.6)])])
+    mesh = valid(aftmesh.generate(gc, 0.1), 2.0)
+    assert shortest_edge(mesh) > 0.02         # 3.3e-16
+    gc = GeometryCollection([box(0, 0, 2, 1), Point(1.0, 0.0)])
+    mesh = valid(aftmesh.generate(gc, 0.1), 2.0)
+    assert shortest_edge(mesh) > 0.02
+
+
+def test_regression_t_junction_shared_edge_discretized_twice():
+    """Regions box(0,0,1,2) and box(1,0,2,1) share the edge x = 1, 0 <= y <= 1; it is
+    discretized once per region (13 pieces per 2 and 7 per 1, interleaved), not once:
+    vertices 0.011 apart for a size of 0.15, angles of 2.8 degrees."""
+    mesh = valid(aftmesh.generate([box(0, 0, 1, 2), box(1, 0, 2, 1)], 0.15), 3.0)
+    P = np.asarray(mesh.points)
+    y = np.sort(P[(P[:, 0] == 1.0) & (P[:, 1] <= 1.0), 1])
+    assert np.diff(y).min() > 0.05, np.round(y, 4)
+    assert mesh.quality()["min_angle"] > 15
+
+
+def test_regression_repeated_closing_vertex_zero_division():
+    """A ring whose closing vertex is repeated three times: ZeroDivisionError in
+    generate (a zero-length edge survives the clean-up, the size becomes 0)."""
+    ring = [(0, 0), (1, 0), (0, 1), (0, 0), (0, 0), (0, 0)]
+    for domain in (np.array(ring, dtype=float), Polygon(ring)):
+        mesh = valid(aftmesh.generate(domain, 0.3), 0.5)
+        assert len(mesh.points) == len(np.unique(mesh.points, axis=0))
+
+
 def test_triangle_style_dict_with_holes_and_regions():
     d = dict(vertices=[(0, 0), (2.5, 0), (4, 0), (4, 4), (2.5, 4), (0, 4),
                        (1, 1), (2, 1), (2, 2), (1, 2)],
@@ -206,6 +297,28 @@ def test_triangle_style_dict_with_holes_and_regions():
     for (u, v), k in zip(np.asarray(mesh.segments), np.asarray(mesh.segment_markers)):
         assert 0 <= k < len(S)
         assert dc.points_on_edges(P[[u, v]], np.array([V[S[k]]]), tol=1e-9).all()
+
+
+def test_dict_nested_regions_match_triangle():
+    """Nested square rings with region points and a hole in the middle: the area of
+    each region marker is the one Triangle's regional attributes ('A') give."""
+    rings = [box(-k, -k, k, k).exterior.coords[:-1] for k in (4, 3, 2, 1)]
+    V = np.concatenate([np.asarray(r, dtype=float) for r in rings])
+    S = np.concatenate([np.c_[np.arange(4), (np.arange(4) + 1) % 4] + 4 * i
+                        for i in range(4)])
+    d = dict(vertices=V, segments=S, holes=np.array([[0.0, 0.0]]),
+             regions=np.array([[3.5, 0, 7, 0], [2.5, 0, 8, 0], [0, 1.5, 9, 0]]))
+    ref = triangle.triangulate(d, "pA")
+    p = ref["vertices"][ref["triangles"]]
+    a = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+                     - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    att = ref["triangle_attributes"][:, 0]
+    expected = {int(k): float(a[att == k].sum()) for k in np.unique(att)}
+    assert expected == pytest.approx({7: 28.0, 8: 20.0, 9: 12.0})
+    for kw in ({"size": 0.5}, {"split_boundary": False}):
+        mesh = valid(aftmesh.generate(d, **kw), 60.0)
+        assert region_areas(mesh) == pytest.approx(expected, rel=1e-12)
+        assert sorted(r[3] for r in count_formula(mesh)) == [1]
 
 
 def test_poly_file_path(tmp_path):

@@ -31,11 +31,11 @@ from aftmesh.checks import check_mesh, count_formula
 
 import domain_cases as dc
 
-# check_mesh's own empty-circle test uses the kernel's incircle predicate, which is
-# not exact yet (see test_regression_check_mesh_incircle_not_exact): it reports
-# exactly cocircular, Delaunay configurations as violations.  The Delaunay property is
-# judged here by dc.assert_cdt instead (Triangle, then exact rational arithmetic).
-CHECKER_DELAUNAY = False
+# check_mesh's own empty-circle test uses the kernel's incircle predicate (it was not
+# exact at first: test_regression_check_mesh_incircle_not_exact).  The Delaunay
+# property is also judged independently by dc.assert_cdt (Triangle, then exact
+# rational arithmetic where points are cocircular).
+CHECKER_DELAUNAY = True
 
 SHAPELY_CASES = dc.shapely_cases()
 SAMPLE_CASES = [dc.triangle_sample(n) for n in dc.TRIANGLE_SAMPLES]
@@ -48,6 +48,7 @@ EXPECTED_M = {
     "serpentine": [0], "9holes-square": [9], "16holes-circle": [16],
     "hole-touch-vertex": [0], "hole-touch-edge": [0], "holes-touch": [1],
     "touch-corner": [0, 0], "touch-vertex-edge": [0, 0], "annulus": [1],
+    "L+1e+06": [0], "annulus*1e-06": [1], "slot": [0], "spiral": [0], "sliver": [0],
     "poly:A": [1], "poly:double_hex": [2], "poly:double_hex2": [2],
     "poly:double_hex3": [2], "poly:face": [3], "poly:la": [0],
     "poly:square_circle_hole": [1],
@@ -121,6 +122,17 @@ def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=No
                 np.asarray(edges).reshape(-1, 2), axis=0)
             assert dc.edge_keys(mesh.points, mesh.segments) == \
                 dc.split_at_vertices(edges, verts)
+    if edges is not None:
+        # no near-duplicate vertices: no mesh edge is much shorter than both the
+        # shortest input edge and the size (the pieces of an input edge are at least
+        # about a size long, and the algorithm refuses R too close to S)
+        E = np.asarray(edges, dtype=float)
+        shortest_in = np.linalg.norm(E[:, 1] - E[:, 0], axis=1).min()
+        h = case.size if case is not None else shortest_in
+        P = np.asarray(mesh.points)
+        e = mesh.edges
+        shortest_out = np.linalg.norm(P[e[:, 1]] - P[e[:, 0]], axis=1).min()
+        assert shortest_out >= 1e-3 * min(shortest_in, h), (shortest_out, shortest_in, h)
     rows = assert_count_formula(mesh, EXPECTED_M.get(case.name) if case is not None else None)
     if case is not None and not isinstance(case.domain, dict):
         # no input vertex inside these domains: the interior vertices are exactly the

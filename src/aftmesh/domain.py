@@ -36,7 +36,8 @@ class Domain:
     """A PSLG plus what is needed to mesh it.
 
     ``segment_source[k]`` numbers the input ring / constraint line segment k came from
-    (``source_names`` says which); ``polygons`` classify the pieces cut out by the
+    (``source_names`` says which; ``source_markers``, if the input had them, maps that
+    number to the user's own segment marker); ``polygons`` classify the pieces cut out by the
     segments into regions (index in the list; outside all: not meshed).  Dict and
     ``.poly`` inputs instead carry Triangle's ``holes`` and ``region_points``."""
 
@@ -49,6 +50,7 @@ class Domain:
     region_points: np.ndarray | None = None
     area: float | None = None
     cleanup: list[str] = field(default_factory=list)
+    source_markers: np.ndarray | None = None    # the user's marker of each source
 
 
 def _is_coordinate_array(obj) -> bool:
@@ -102,15 +104,15 @@ def _check_polygon(poly: Polygon, where: str) -> None:
 def _clean_ring(coords: np.ndarray, note: list[str], name: str, keep_collinear: bool):
     """Drop the closing duplicate, repeated vertices and (optionally) collinear runs."""
     c = np.asarray(coords, dtype=np.float64)
-    if len(c) > 1 and (c[0] == c[-1]).all():
-        c = c[:-1]
+    n0 = len(c)
     keep = np.ones(len(c), dtype=bool)
     keep[1:] = (c[1:] != c[:-1]).any(axis=1)
-    if len(c) > 1 and (c[-1] == c[0]).all():
-        keep[-1] = False
-    if not keep.all():
-        note.append(f"{name}: removed {int((~keep).sum())} repeated vertices")
-        c = c[keep]
+    c = c[keep]
+    while len(c) > 1 and (c[-1] == c[0]).all():     # the closing vertex, given or not
+        c = c[:-1]
+    removed = n0 - len(c) - (1 if n0 > 1 and (np.asarray(coords)[0] == np.asarray(coords)[-1]).all() else 0)
+    if removed > 0:
+        note.append(f"{name}: removed {removed} repeated vertices")
     if not keep_collinear and len(c) > 3:
         from ._kernel import py_orient2d
         changed = True
@@ -182,66 +184,84 @@ def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: lis
 
 
 def _merge_and_node(verts, segs, src, note):
-    """Merge coincident vertices, drop segments given twice (a boundary shared by two
-    regions), and split segments at input vertices lying exactly on them or at points
-    where two segments cross (shapely's noding finds those)."""
+    """Make the input edges a proper PSLG: merge coincident vertices, split every
+    segment at the input vertices lying exactly inside it (a hole touching the outer
+    ring, a T-junction between regions, a constraint line ending on a boundary), drop
+    segments given twice (a boundary shared by two regions), and split segments that
+    cross each other at their crossing points."""
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
-    segs = inverse[segs]
-    key = np.sort(segs, axis=1)
-    _, first = np.unique(key, axis=0, return_index=True)
-    first.sort()
-    segs, src = segs[first], src[first]
+    segs = inverse.reshape(-1)[segs]
+    segs, src = _split_at_vertices(uniq, segs, src, note)
+    segs, src = _drop_repeats(segs, src)
     if len(segs) == 0:
         return uniq, segs, src
-    # noding: find crossings between segments (shapely, exact enough on inputs that
-    # really cross; touching at input vertices is handled by the CDT itself)
+    # crossings (shapely finds them; touching at vertices was handled above)
     lines = shapely.linestrings(np.stack([uniq[segs[:, 0]], uniq[segs[:, 1]]], axis=1))
-    tree = shapely.STRtree(lines)
-    pairs = tree.query(lines, predicate="crosses")
+    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
     pairs = pairs[:, pairs[0] < pairs[1]]
     if pairs.shape[1] == 0:
         return uniq, segs, src
-    # split each crossing segment at its crossing points
-    cuts: dict[int, list[np.ndarray]] = {}
+    extra = []
     for i, j in pairs.T:
-        inter = shapely.intersection(lines[i], lines[j])
-        for p in shapely.get_parts(inter):
+        for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
             if isinstance(p, Point):
-                xy = np.asarray(p.coords)[0, :2]
-                cuts.setdefault(int(i), []).append(xy)
-                cuts.setdefault(int(j), []).append(xy)
-    new_pts = [uniq]
-    new_segs = []
-    new_src = []
-    base = len(uniq)
-    extra: list[np.ndarray] = []
-    for k in range(len(segs)):
-        if k not in cuts:
-            new_segs.append(segs[k][None, :])
-            new_src.append([src[k]])
-            continue
-        a, b = uniq[segs[k, 0]], uniq[segs[k, 1]]
-        d = b - a
-        pts = np.unique(np.array(cuts[k]), axis=0)
-        t = (pts - a) @ d / (d @ d)
-        order = np.argsort(t)
-        chain = [segs[k, 0]]
-        for p in pts[order]:
-            extra.append(p)
-            chain.append(base + len(extra) - 1)
-        chain.append(segs[k, 1])
-        new_segs.append(np.c_[chain[:-1], chain[1:]])
-        new_src.append([src[k]] * (len(chain) - 1))
-    note.append(f"split {len(cuts)} segments at {pairs.shape[1]} crossings")
-    new_pts.append(np.array(extra).reshape(-1, 2))
-    verts = np.concatenate(new_pts)
-    segs = np.concatenate(new_segs)
-    src = np.concatenate([np.asarray(s) for s in new_src])
+                extra.append(np.asarray(p.coords)[0, :2])
+    note.append(f"split segments at {pairs.shape[1]} crossings")
+    verts = np.concatenate([uniq, np.array(extra).reshape(-1, 2)])
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
-    keep = segs[:, 0] != segs[:, 1]
-    return uniq, segs[keep], src[keep]
+    segs, src = _split_at_vertices(uniq, segs, src, None)
+    segs, src = _drop_repeats(segs, src)
+    return uniq, segs, src
+
+
+def _drop_repeats(segs, src):
+    key = np.sort(segs, axis=1)
+    keep = key[:, 0] != key[:, 1]
+    _, first = np.unique(key, axis=0, return_index=True)
+    first = np.sort(first[keep[first]])
+    return segs[first], src[first]
+
+
+def _split_at_vertices(pts, segs, src, note):
+    """Split each segment at the vertices lying exactly on its interior (decided with
+    the exact orientation predicate after a shapely candidate search)."""
+    from ._kernel import py_orient2d
+    if len(segs) == 0:
+        return segs, src
+    lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
+    # candidates: vertices within a tiny distance of a segment (shapely's own test may
+    # miss a point that is exactly on the segment but not representable on its line)
+    tol = 1e-12 * float(np.abs(pts).max() + 1.0)
+    vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=tol)
+    cuts: dict[int, list[int]] = {}
+    for v, k in zip(vi.tolist(), si.tolist()):
+        a, b = segs[k]
+        if v == a or v == b:
+            continue
+        pa, pb, pv = pts[a], pts[b], pts[v]
+        if py_orient2d(pa[0], pa[1], pb[0], pb[1], pv[0], pv[1]) != 0:
+            continue
+        if np.dot(pv - pa, pb - pa) > 0 and np.dot(pv - pb, pa - pb) > 0:
+            cuts.setdefault(k, []).append(v)
+    if not cuts:
+        return segs, src
+    if note is not None:
+        note.append(f"split {len(cuts)} segments at vertices lying on them")
+    out_s, out_src = [], []
+    for k in range(len(segs)):
+        if k not in cuts:
+            out_s.append(segs[k][None, :])
+            out_src.append([src[k]])
+            continue
+        a, b = segs[k]
+        d = pts[b] - pts[a]
+        inner = sorted(set(cuts[k]), key=lambda v: float(np.dot(pts[v] - pts[a], d)))
+        chain = [a, *inner, b]
+        out_s.append(np.c_[chain[:-1], chain[1:]])
+        out_src.append([src[k]] * (len(chain) - 1))
+    return (np.concatenate(out_s).astype(np.int64),
+            np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64))
 
 
 def _from_dict(d: dict) -> Domain:
@@ -261,20 +281,28 @@ def _from_dict(d: dict) -> Domain:
             raise InvalidInputError(f"regions must have shape (r, 3) or (r, 4), got {reg.shape}")
         reg = reg[:, :3]
     markers = d.get("segment_markers")
-    src = np.arange(len(seg), dtype=np.int32) if markers is None else \
-        np.asarray(markers, dtype=np.int32).reshape(-1)
-    if len(src) != len(seg):
-        raise InvalidInputError(
-            f"segment_markers has {len(src)} entries for {len(seg)} segments")
-    return Domain(pts, seg, src, [f"segment {i}" for i in range(len(seg))],
-                  holes=holes, region_points=reg)
+    src = np.arange(len(seg), dtype=np.int32)
+    if markers is not None:
+        markers = np.asarray(markers).reshape(-1)
+        if len(markers) != len(seg):
+            raise InvalidInputError(
+                f"segment_markers has {len(markers)} entries for {len(seg)} segments")
+        if not np.issubdtype(markers.dtype, np.integer):
+            raise InvalidInputError("segment_markers must be integers")
+        markers = markers.astype(np.int32)
+    return Domain(pts, seg, src, [f"segments[{i}]" for i in range(len(seg))],
+                  holes=holes, region_points=reg, source_markers=markers)
 
 
 def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
     """Convert any accepted domain form into a :class:`Domain` (see module doc)."""
     if isinstance(domain, (str, PathLike)):
         from .io import read_poly
-        return _from_dict(read_poly(domain))
+        try:
+            return _from_dict(read_poly(domain))
+        except OSError as exc:
+            # a wrong path is the caller's input error like any other
+            raise InvalidInputError(f"cannot read the domain file {str(domain)!r}: {exc}") from None
     if isinstance(domain, dict):
         return _from_dict(domain)
     if isinstance(domain, shapely.Geometry):

@@ -11,7 +11,8 @@ from .aft import Strategy, basic_aft
 from .boundary import discretize
 from .cdt import segment_markers
 from .domain import to_domain
-from .errors import InvalidDomainError, InvalidOptionError, InvalidSizeError
+from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
+                     InvalidSizeError)
 from .mesh import Mesh
 from .pslg import build_cdt
 from .sizing import DEFAULT_GRADATION, make_size_field, per_region_size
@@ -50,7 +51,10 @@ def _progress_callback(progress, expected_triangles: int):
     return _ProgressBar(sys.stderr) if progress else None
 
 
-def _check_options(order, max_triangles, min_area, close_factor):
+def _check_options(order, max_triangles, min_area, close_factor, flags):
+    for name, value in flags.items():
+        if not isinstance(value, (bool, np.bool_)):
+            raise InvalidOptionError(f"{name} must be True or False, got {value!r}")
     if order not in _ORDERS:
         raise InvalidOptionError(
             f"order={order!r} is not a valid option, must be one of {sorted(_ORDERS)}")
@@ -136,7 +140,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     True
     """
     t_start = time.perf_counter()
-    _check_options(order, max_triangles, min_area, close_factor)
+    _check_options(order, max_triangles, min_area, close_factor,
+                   dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary))
     dom = to_domain(domain, keep_vertices=not split_boundary)
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
@@ -164,8 +169,16 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     t_boundary = time.perf_counter()
     area_hint = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
     nt_hint = int(min(4e8, 2.5 * area_hint / (0.43 * field.h_min ** 2) + 4 * len(verts)))
-    built = build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
-                      nt_hint=min(nt_hint, 50_000_000))
+    try:
+        built = build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
+                          nt_hint=min(nt_hint, 50_000_000))
+    except CrossingSegmentsError as err:
+        # name the user's segments / rings, not the pieces the discretization made
+        names = [dom.source_names[src[k]] for k in err.segments if 0 <= k < len(src)]
+        where = [verts[segs[k]].tolist() for k in err.segments if 0 <= k < len(src)]
+        detail = " and ".join(f"{n} (near {w[0]} -> {w[1]})" for n, w in zip(names, where))
+        raise CrossingSegmentsError(f"these input edges cross: {detail}",
+                                    tuple(int(src[k]) for k in err.segments)) from None
     kernel = built.kernel
     if dom.polygons is not None:
         comp, probes = kernel.components()
@@ -214,6 +227,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     to_out = a["vertex_map"][built.merged]
     pieces = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
     markers = np.where(pieces >= 0, src[np.maximum(pieces, 0)], -1).astype(np.int32)
+    if dom.source_markers is not None:
+        markers = np.where(markers >= 0, dom.source_markers[np.maximum(markers, 0)], -1)
     counters = kernel.counters()
     info = {
         "merged_vertices": built.n_merged,
