@@ -27,10 +27,16 @@ def _machine() -> str:
                     break
     except OSError:
         pass
-    load = ""
-    if hasattr(os, "getloadavg"):
-        load = f", load {os.getloadavg()[0]:.2f} at start"
-    return f"{cpu}, {os.cpu_count()} cores{load}"
+    return f"{cpu}, {os.cpu_count()} cores"
+
+
+def _load() -> float | None:
+    return os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+
+
+def _meta(quick: bool) -> dict:
+    return {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
+            "machine": _machine(), "quick": quick, "load_start": _load()}
 
 
 def _versions() -> str:
@@ -97,8 +103,6 @@ def main(argv=None) -> int:
             results = {}
 
     if not args.report_only:
-        meta = {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
-                "machine": _machine(), "quick": args.quick}
         results["meta"] = {"versions": _versions()}
         run_mesh = args.all or args.cases or not (args.scaling or args.cdt)
         t_all = time.perf_counter()
@@ -107,19 +111,22 @@ def main(argv=None) -> int:
             meshers = args.meshers or DEFAULT_MESHERS
             limit = args.gmsh_limit if args.gmsh_limit is not None else (3e4 if args.quick else 1e6)
             print(f"meshing: {len(names)} cases x {len(meshers)} meshers")
+            meta = _meta(args.quick)
             sec = runner.run_mesh_suite(names, meshers, quick=args.quick, repeat=args.repeat,
                                         gmsh_limit=limit)
-            sec["meta"] = meta
+            sec["meta"] = {**meta, "load_end": _load()}
             results["mesh"] = sec
         if args.cdt or args.all:
             print("CDT:")
+            meta = _meta(args.quick)
             sec = runner.run_cdt_suite(quick=args.quick, repeat=args.repeat)
-            sec["meta"] = meta
+            sec["meta"] = {**meta, "load_end": _load()}
             results["cdt"] = sec
         if args.scaling or args.all:
             print("scaling:")
+            meta = _meta(args.quick)
             sec = runner.run_scaling(quick=args.quick, repeat=args.repeat)
-            sec["meta"] = meta
+            sec["meta"] = {**meta, "load_end": _load()}
             results["scaling"] = sec
         print(f"(measured in {time.perf_counter() - t_all:.1f} s)")
         store.write_text(json.dumps(results, indent=1))

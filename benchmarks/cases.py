@@ -254,8 +254,8 @@ HOLES_H = (0.01, 0.005)
 ALL_CASES = ([f"square-{h:g}" for h in SQUARE_H] + [f"holes-{h:g}" for h in HOLES_H]
              + ["naca0012"] + [f"poly-{p}" for p in POLY_FILES] + ["comb", "inclusion"])
 
-QUICK_CASES = ["square-0.01", "square-0.005", "holes-0.01", "naca0012", "poly-A",
-               "poly-face", "comb", "inclusion"]
+QUICK_CASES = ["square-0.01", "square-0.005", "naca0012", "poly-A", "poly-face", "comb",
+               "inclusion"]
 
 
 def case_names() -> list[str]:

@@ -130,7 +130,7 @@ def _triangle(case: Case, switches: str) -> Runner:
                    "segments": r["segments"], "triangle_max_area": target}
             if "triangle_attributes" in r:
                 inp["triangle_attributes"] = r["triangle_attributes"]
-            r = triangle.triangulate(inp, "r" + switches + "a")
+            r = triangle.triangulate(inp, "r" + switches + "a" + extra)
             passes += 1
         runner.passes = passes
         return r

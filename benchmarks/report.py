@@ -45,8 +45,8 @@ def _label(m):
     return MESHERS.get(m, (m, ""))[0]
 
 
-MESH_HEADER = ("| mesher | triangles | time (median) | runs | tri/s | time / Tri pq30 | "
-               "tri/s / Tri pq30 | peak mem (MiB) | seg + | min angle | max angle | "
+MESH_HEADER = ("| mesher | triangles | time (median) | CPU (median) | runs | tri/s | "
+               "time / Tri pq30 | CPU / Tri pq30 | tri/s / Tri pq30 | peak mem (MiB) | seg + | min angle | max angle | "
                "RR mean | RR min | RR < 0.6 | RR > 0.9 | edge/size mean ± std |")
 
 
@@ -82,10 +82,10 @@ def mesh_tables(mesh: dict) -> list[str]:
                 continue
             label = _label(r["mesher"])
             if r.get("skipped"):
-                out.append(f"| {label} | {_esc(r['skipped'])} |" + " - |" * 14)
+                out.append(f"| {label} | {_esc(r['skipped'])} |" + " - |" * 16)
                 continue
             if "median" not in r:
-                out.append(f"| {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 14)
+                out.append(f"| {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 16)
                 continue
             s = r["stats"]
             seg_plus = s["segments_out"] - s["segments_in"]
@@ -102,9 +102,10 @@ def mesh_tables(mesh: dict) -> list[str]:
             if "edge_ratio_mean" in s:
                 edge = f"{s['edge_ratio_mean']:.3f} ± {s['edge_ratio_std']:.3f}"
             out.append(
-                f"| {label} | {s['triangles']} | {_t(r['median'])}{note} | {len(r['times'])} | "
+                f"| {label} | {s['triangles']} | {_t(r['median'])}{note} | "
+                f"{_t(r.get('cpu_median'))} | {len(r['times'])} | "
                 f"{_rate(r['tri_per_s'])} | {_f(r.get('time_ratio'), '{:.2f}')} | "
-                f"{_f(r.get('rate_ratio'), '{:.2f}')} | {r['mem_mib']:.1f} | {seg_plus:+d} | "
+                f"{_f(r.get('cpu_ratio'), '{:.2f}')} | {_f(r.get('rate_ratio'), '{:.2f}')} | {r['mem_mib']:.1f} | {seg_plus:+d} | "
                 f"{s['min_angle']:.2f} | {s['max_angle']:.2f} | {s['rr_mean']:.4f} | "
                 f"{s['rr_min']:.3f} | {_pct(s['rr_below_0.6'])} | {_pct(s['rr_above_0.9'])} | "
                 f"{edge} |")
@@ -131,10 +132,9 @@ def internal_table(mesh: dict) -> list[str]:
            "segment markers, the Mesh object).", "", hdr, _rule(hdr)]
     for r in rows:
         t = r["internal_timing"]
-        parts = [t.get(k) for k in ("boundary", "cdt", "basic_aft", "total")]
-        tail = parts[3] - sum(parts[:3]) if None not in parts else None
+        parts = [t.get(k) for k in ("boundary", "cdt", "basic_aft", "after", "total")]
         out.append(f"| {r['case']} | {_label(r['mesher'])} | {_t(parts[0])} | "
-                   f"{_t(parts[1])} | {_t(parts[2])} | {_t(tail)} | {_t(parts[3])} | "
+                   f"{_t(parts[1])} | {_t(parts[2])} | {_t(parts[3])} | {_t(parts[4])} | "
                    f"{_t(r.get('median'))} |")
     out.append("")
     return out
@@ -142,17 +142,20 @@ def internal_table(mesh: dict) -> list[str]:
 
 def cdt_tables(cdt: dict) -> list[str]:
     out = []
-    hdr = "| input | tool | triangles | time (median) | runs | time / Triangle |"
+    hdr = ("| input | tool | triangles | time (median) | CPU (median) | runs | time / Triangle | "
+           "CPU / Triangle |")
     out += [hdr, _rule(hdr)]
     names = {"aft": "aftmesh.cdt", "tri": "triangle.triangulate", "scipy": "scipy Delaunay (Qhull)"}
     for r in cdt["rows"]:
         tool = names.get(r["tool"], r["tool"])
         if "median" not in r:
-            out.append(f"| {r['input']} | {tool} | ERROR: {_esc(str(r.get('error')))} | - | - | - |")
+            out.append(f"| {r['input']} | {tool} | ERROR: {_esc(str(r.get('error')))} |"
+                       + " - |" * 5)
             continue
         extra = " (unconstrained)" if r["tool"] == "scipy" and r.get("n_segments") else ""
         out.append(f"| {r['input']} | {tool}{extra} | {r['triangles']} | {_t(r['median'])} | "
-                   f"{len(r['times'])} | {_f(r.get('time_ratio'), '{:.2f}')} |")
+                   f"{_t(r.get('cpu_median'))} | {len(r['times'])} | "
+                   f"{_f(r.get('time_ratio'), '{:.2f}')} | {_f(r.get('cpu_ratio'), '{:.2f}')} |")
     out.append("")
     hdr = "| 1e6 random points | triangles | time (one run) | peak mem delta (MiB) | bytes / triangle |"
     out += [hdr, _rule(hdr)]
@@ -169,21 +172,26 @@ def cdt_tables(cdt: dict) -> list[str]:
 
 def scaling_tables(sc: dict) -> list[str]:
     out = []
-    hdr = "| h | mesher | triangles | time (median) | runs | tri/s | peak mem (MiB) | bytes / triangle |"
+    hdr = ("| h | mesher | triangles | time (median) | CPU (median) | runs | tri/s | "
+           "peak mem (MiB) | bytes / triangle |")
     out += [hdr, _rule(hdr)]
     for r in sc["rows"]:
         label = _label(r["mesher"])
         if "median" not in r:
-            out.append(f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} | - | - | - | - | - |")
+            out.append(f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} |"
+                       + " - |" * 6)
             continue
         n = r["triangles"]
-        out.append(f"| {r['h']:g} | {label} | {n} | {_t(r['median'])} | {len(r['times'])} | "
+        out.append(f"| {r['h']:g} | {label} | {n} | {_t(r['median'])} | "
+                   f"{_t(r.get('cpu_median'))} | {len(r['times'])} | "
                    f"{_rate(n / r['median'])} | {r['mem_mib']:.1f} | "
                    f"{r['mem_mib'] * 1048576 / n:.0f} |")
     out.append("")
     for m, fit in sc["fits"].items():
-        out.append(f"- {_label(m)}: time ~ triangles^{_f(fit['all'], '{:.3f}')} over all sizes, "
-                   f"^{_f(fit['from_1e5'], '{:.3f}')} from 1e5 triangles up (least squares, log-log)")
+        out.append(f"- {_label(m)}: wall time ~ triangles^{_f(fit['all'], '{:.3f}')} over all "
+                   f"sizes, ^{_f(fit['from_1e5'], '{:.3f}')} from 1e5 triangles up; CPU time "
+                   f"^{_f(fit.get('cpu_all'), '{:.3f}')} and ^{_f(fit.get('cpu_from_1e5'), '{:.3f}')} "
+                   "(least squares, log-log)")
     out.append("")
     return out
 
@@ -191,7 +199,11 @@ def scaling_tables(sc: dict) -> list[str]:
 def _section_head(title: str, sec: dict) -> list[str]:
     m = sec.get("meta", {})
     mode = "quick" if m.get("quick") else "full"
-    return [f"### {title}", "", f"_{mode} run, {m.get('date', '?')}, {m.get('machine', '')}_", ""]
+    load = ""
+    if m.get("load_start") is not None:
+        load = f", load average {m['load_start']:.2f} at start, {m.get('load_end', 0):.2f} at end"
+    return [f"### {title}", "", f"_{mode} run, {m.get('date', '?')}, {m.get('machine', '')}{load}_",
+            ""]
 
 
 def full_report(results: dict) -> str:
@@ -225,7 +237,7 @@ def summary(results: dict) -> str:
                    "RR = radius ratio 2 r_in / r_circ.")
         out.append("")
         hdr = ("| case | aftmesh triangles | aftmesh time | Triangle pq30a time | time ratio | "
-               "tri/s ratio | Gmsh alg 6 time | RR mean aft / Tri / Gmsh6 | "
+               "CPU ratio | tri/s ratio | Gmsh alg 6 time | RR mean aft / Tri / Gmsh6 | "
                "min angle aft / Tri / Gmsh6 |")
         out += [hdr, _rule(hdr)]
         by = {(r["case"], r["mesher"]): r for r in mesh["rows"]}
@@ -239,7 +251,8 @@ def summary(results: dict) -> str:
             out.append(
                 f"| {cname} | {a.get('triangles', '-') if 'median' in a else 'error'} | "
                 f"{_t(a.get('median'))} | {_t(t.get('median'))} | "
-                f"{_f(a.get('time_ratio'), '{:.2f}')} | {_f(a.get('rate_ratio'), '{:.2f}')} | "
+                f"{_f(a.get('time_ratio'), '{:.2f}')} | {_f(a.get('cpu_ratio'), '{:.2f}')} | "
+                f"{_f(a.get('rate_ratio'), '{:.2f}')} | "
                 f"{_t(g.get('median'))} | "
                 f"{q(a, 'rr_mean', '{:.3f}')} / {q(t, 'rr_mean', '{:.3f}')} / {q(g, 'rr_mean', '{:.3f}')} | "
                 f"{q(a, 'min_angle', '{:.1f}')} / {q(t, 'min_angle', '{:.1f}')} / {q(g, 'min_angle', '{:.1f}')} |")

@@ -100,12 +100,13 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
                 log(f"  {cname:18s} {mname:14s} {row['skipped']}")
                 continue
             job = {"kind": "mesh", "case": cname, "mesher": mname, "repeat": repeat,
-                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 0.5 if quick else 60.0,
+                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 0.25 if quick else 60.0,
                    "edges": True}
             res = run_job(job, timeout=120 if quick else 1200)
             row.update(res)
             if "times" in res:
                 row["median"] = _median(res["times"])
+                row["cpu_median"] = _median(res["cpu"])
                 row["triangles"] = res["stats"]["triangles"]
                 if mname == "aft":
                     aft_triangles = row["triangles"]
@@ -123,6 +124,7 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
             if ref:
                 r["time_ratio"] = r["median"] / ref["median"]
                 r["rate_ratio"] = r["tri_per_s"] / ref["tri_per_s"]
+                r["cpu_ratio"] = r["cpu_median"] / ref["cpu_median"]
     return {"rows": rows, "cases": cases_meta, "meshers": {m: MESHERS[m] for m in mesher_names},
             "reference": REFERENCE}
 
@@ -143,11 +145,13 @@ def run_cdt_suite(*, quick: bool, repeat: int, log=print) -> dict:
     for r in rows:
         if "times" in r:
             r["median"] = _median(r["times"])
+            r["cpu_median"] = _median(r["cpu"])
     for r in rows:
         ref = next((x for x in rows if x["input"] == r["input"] and x["tool"] == "tri"
                     and x.get("median")), None)
         if r.get("median") and ref:
             r["time_ratio"] = r["median"] / ref["median"]
+            r["cpu_ratio"] = r["cpu_median"] / ref["cpu_median"]
         if r.get("median"):
             log(f"  {r['input']:32s} {r['tool']:6s} {r['median']:.4f} s  {r['triangles']} tri")
     mem = []
@@ -188,6 +192,7 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
             row = {"h": h, "mesher": mname, **res}
             if "times" in res:
                 row["median"] = _median(res["times"])
+                row["cpu_median"] = _median(res["cpu"])
                 row["triangles"] = res["stats"]["triangles"]
                 log(f"  h={h:<8g} {mname:10s} {row['triangles']:>9d} tri  {row['median']:.4f} s"
                     f"  {res['mem_mib']:.0f} MiB")
@@ -201,5 +206,8 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
         fits[mname] = {
             "all": fit_exponent([r["triangles"] for r in ok], [r["median"] for r in ok]),
             "from_1e5": fit_exponent([r["triangles"] for r in big], [r["median"] for r in big]),
+            "cpu_all": fit_exponent([r["triangles"] for r in ok], [r["cpu_median"] for r in ok]),
+            "cpu_from_1e5": fit_exponent([r["triangles"] for r in big],
+                                         [r["cpu_median"] for r in big]),
         }
     return {"rows": rows, "fits": fits}

@@ -41,9 +41,11 @@ def mesh_job(job: dict) -> dict:
     runner = prepare(name, case)
     probe = MemoryProbe()
     probe.start()
+    c0 = time.process_time()
     t0 = time.perf_counter()
     raw = runner.run()
     times = [time.perf_counter() - t0]
+    cpu = [time.process_time() - c0]
     mem = probe.stop_mib()
     timings = [_internal_timing(raw)]
     out = runner.result(raw)
@@ -59,16 +61,18 @@ def mesh_job(job: dict) -> dict:
             break
         runner.reset()
         gc.collect()
+        c0 = time.process_time()
         t0 = time.perf_counter()
         raw = runner.run()
         times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
         timings.append(_internal_timing(raw))
         del raw
     runner.close()
     internal = None
     if all(timings):
         internal = {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
-    return {"times": times, "mem_mib": mem, "mem_method": probe.method, "stats": stats,
+    return {"times": times, "cpu": cpu, "mem_mib": mem, "mem_method": probe.method, "stats": stats,
             "passes": passes, "internal_timing": internal}
 
 
@@ -76,7 +80,10 @@ def _internal_timing(raw):
     """aftmesh's own split of the time (``Mesh.info['timing']``), else None."""
     info = getattr(raw, "info", None)
     if isinstance(info, dict) and isinstance(info.get("timing"), dict):
-        return {k: float(v) for k, v in info["timing"].items()}
+        t = {k: float(v) for k, v in info["timing"].items()}
+        if all(k in t for k in ("boundary", "cdt", "basic_aft", "total")):
+            t["after"] = t["total"] - t["boundary"] - t["cdt"] - t["basic_aft"]
+        return t
     return None
 
 
@@ -158,13 +165,15 @@ def cdt_speed_job(job: dict) -> dict:
                    "n_segments": 0 if segs is None else int(len(segs))}
             try:
                 call = _cdt_call(tool, pts, segs)
-                times, ntri = [], None
+                times, cpu, ntri = [], [], None
                 for _ in range(job["repeat"] if len(pts) < 500_000 else job["repeat_big"]):
                     gc.collect()
+                    c0 = time.process_time()
                     t0 = time.perf_counter()
                     ntri = call()
                     times.append(time.perf_counter() - t0)
-                row.update(times=times, triangles=int(ntri))
+                    cpu.append(time.process_time() - c0)
+                row.update(times=times, cpu=cpu, triangles=int(ntri))
             except Exception as exc:
                 row["error"] = f"{type(exc).__name__}: {exc}"
             rows.append(row)

@@ -1,9 +1,8 @@
 # Smoothing after the front has closed (optional, on by default in generate()).
 #
 # Each pass moves every vertex that Basic_aft created (the input vertices never move)
-# towards the position that would make its triangles equilateral, when that keeps
-# them all counter-clockwise (exact orient2d) and does not spoil the worst, and then
-# restores the constrained Delaunay
+# to the best of a few candidate places, judged by the worst shape of its triangles,
+# when that keeps them all counter-clockwise (exact orient2d), and then restores the constrained Delaunay
 # property by Lawson flips over the whole mesh, so the result is still the CDT of its
 # vertices and the input edges.
 
@@ -30,16 +29,30 @@ cdef double _worst_around(Tri* T, int e0) noexcept nogil:
             return worst
 
 
+cdef double _try_at(Tri* T, int v, int e0, double x, double y) noexcept nogil:
+    """Worst shape around v if it stood at (x, y) (v is put back afterwards)."""
+    cdef double ox = T.xy[2 * v], oy = T.xy[2 * v + 1], q
+    T.xy[2 * v] = x
+    T.xy[2 * v + 1] = y
+    q = _worst_around(T, e0)
+    T.xy[2 * v] = ox
+    T.xy[2 * v + 1] = oy
+    return q
+
+
 cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
-    """Move v to the mean, over its triangles, of the midpoint between a neighbour and
-    the ideal apex (the one that would make the triangle equilateral on its edge
-    opposite v): half Laplacian, half "equilateral" smoothing, which measured better
-    than either alone.  The move is kept only if every triangle around v stays
-    counter-clockwise and the worst of them loses at most 0.02 of shape quality (a
-    small loss lets a vertex leave a local optimum that blocks its neighbours).
-    Returns 1 if v moved."""
-    cdef int e0 = T.vhe[v], e = e0, guard = 0, n = 0, u, w
-    cdef double sx = 0.0, sy = 0.0, ox, oy, mx, my, before, after
+    """Move v to whichever of a few candidate places makes the worst of its triangles
+    best: the mean of its neighbours (Laplacian), the mean of its triangles' ideal
+    apexes (each the point that would make that triangle equilateral on its edge
+    opposite v), and two steps towards the ideal apex of its worst triangle.  The move
+    is kept only if it improves the worst shape (so smoothing never makes the worst
+    triangle around a vertex worse) and every triangle stays counter-clockwise (exact
+    orient2d).  Returns 1 if v moved."""
+    cdef int e0 = T.vhe[v], e = e0, guard = 0, n = 0, u, w, k
+    cdef double lx = 0.0, ly = 0.0, ix = 0.0, iy = 0.0, ax, ay, mx, my, q, worst_q = 2.0
+    cdef double wx = 0.0, wy = 0.0, best, bx, by, cx, cy, t
+    cdef double* pu
+    cdef double* pw
     if e0 < 0:
         return 0
     while True:
@@ -47,11 +60,22 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
         w = T.tv[prv(e)]
         if u < 0 or w < 0 or T.tstate[e // 3] != T_MESHED:
             return 0                # on the hull or next to the outside: keep it
+        pu = P(T, u)
+        pw = P(T, w)
         # the equilateral apex on edge u->w, on v's side (left of u->w)
-        mx = 0.5 * (T.xy[2 * u] + T.xy[2 * w])
-        my = 0.5 * (T.xy[2 * u + 1] + T.xy[2 * w + 1])
-        sx += 0.5 * (mx - 0.8660254037844386 * (T.xy[2 * w + 1] - T.xy[2 * u + 1])) + 0.5 * T.xy[2 * u]
-        sy += 0.5 * (my + 0.8660254037844386 * (T.xy[2 * w] - T.xy[2 * u])) + 0.5 * T.xy[2 * u + 1]
+        mx = 0.5 * (pu[0] + pw[0])
+        my = 0.5 * (pu[1] + pw[1])
+        ax = mx - 0.8660254037844386 * (pw[1] - pu[1])
+        ay = my + 0.8660254037844386 * (pw[0] - pu[0])
+        lx += pu[0]
+        ly += pu[1]
+        ix += ax
+        iy += ay
+        q = _shape(P(T, v), pu, pw)
+        if q < worst_q:
+            worst_q = q
+            wx = ax
+            wy = ay
         n += 1
         e = T.twin[prv(e)]
         guard += 1
@@ -59,23 +83,38 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
             break
         if guard > 64:
             return 0
-    before = _worst_around(T, e0)
-    ox = T.xy[2 * v]
-    oy = T.xy[2 * v + 1]
-    T.xy[2 * v] = sx / n
-    T.xy[2 * v + 1] = sy / n
-    after = _worst_around(T, e0)
-    if after >= before - 0.02:
-        e = e0
-        while True:
-            if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
-                break
-            e = T.twin[prv(e)]
-            if e == e0:
-                return 1
-    T.xy[2 * v] = ox
-    T.xy[2 * v + 1] = oy
-    return 0
+    best = worst_q
+    bx = T.xy[2 * v]
+    by = T.xy[2 * v + 1]
+    cx = bx
+    cy = by
+    for k in range(4):
+        if k == 0:
+            ax, ay = lx / n, ly / n
+        elif k == 1:
+            ax, ay = ix / n, iy / n
+        else:
+            t = 0.25 if k == 2 else 0.5
+            ax = cx + t * (wx - cx)
+            ay = cy + t * (wy - cy)
+        q = _try_at(T, v, e0, ax, ay)
+        if q > best + 1e-6:
+            best = q
+            bx = ax
+            by = ay
+    if bx == cx and by == cy:
+        return 0
+    T.xy[2 * v] = bx
+    T.xy[2 * v + 1] = by
+    e = e0
+    while True:
+        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
+            T.xy[2 * v] = cx
+            T.xy[2 * v + 1] = cy
+            return 0
+        e = T.twin[prv(e)]
+        if e == e0:
+            return 1
 
 
 cdef int smooth(Tri* T, int first_movable, int passes) noexcept nogil:
