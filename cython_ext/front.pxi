@@ -397,20 +397,34 @@ cdef inline double _dist2_point_segment(const double* p, const double* a,
     return px * px + py * py
 
 
+cdef inline bint _in_circle_float(const double* a, const double* b, const double* c,
+                                  const double* d) noexcept nogil:
+    """Plain floating-point incircle: only for is_crowded's heuristic cavity, where a
+    wrong answer in a near-tie merely looks at one triangle more or less (the exact
+    predicate there cost a tenth of the run time on near-equilateral meshes)."""
+    cdef double adx = a[0] - d[0], ady = a[1] - d[1]
+    cdef double bdx = b[0] - d[0], bdy = b[1] - d[1]
+    cdef double cdx = c[0] - d[0], cdy = c[1] - d[1]
+    return ((adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
+            + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
+            + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)) > 0.0
+
+
 cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
     """The part of New_is_preferred that needs to know where R lies (so it runs right
     after check_visible found it): R is refused when it would come closer than
     close_factor * h to a vertex it would be joined to, or closer than half that to a
-    constrained edge it would face.  Those are exactly the vertices and constrained
-    edges of R's insertion cavity (the unmeshed triangles whose circumcircles contain R,
-    reached without crossing a constraint), because they become R's neighbours.
+    constrained edge it would face.  Those vertices and edges belong to R's insertion
+    cavity (the unmeshed triangles whose circumcircles contain R, reached without
+    crossing a constraint), because they become R's neighbours; only the part of the
+    cavity within close_factor * h of R can hold them, so the search stays there.
     Returns 1 (crowded), 0, or an error."""
     cdef int n = 0, i, k, e, t, u, j, x, y, z
     cdef double dv2 = (A.close_factor * h) * (A.close_factor * h)
     cdef double de2 = 0.25 * dv2
     cdef double dx, dy
     cdef bint seen
-    if reserve_stack(T, 64):
+    if reserve_stack(T, 32):
         return ERR_NOMEM
     if A.vis_loc == LOC_IN_TRIANGLE:
         T.stack[0] = A.vis_where
@@ -434,18 +448,20 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
                 if _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) < de2:
                     return 1
                 continue
+            if n >= 32 or _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) >= dv2:
+                continue            # the triangle beyond lies outside the search disk
             u = T.twin[e] // 3
             seen = False
             for j in range(n):
                 if T.stack[j] == u:
                     seen = True
                     break
-            if seen or n >= 64:
+            if seen:
                 continue
             x = T.tv[3 * u]
             y = T.tv[3 * u + 1]
             z = T.tv[3 * u + 2]
-            if incircle(P(T, x), P(T, y), P(T, z), R) > 0:
+            if _in_circle_float(P(T, x), P(T, y), P(T, z), R):
                 T.stack[n] = u
                 n += 1
     return 0

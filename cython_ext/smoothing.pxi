@@ -47,7 +47,8 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
     opposite v), and two steps towards the ideal apex of its worst triangle.  The move
     is kept only if it improves the worst shape (so smoothing never makes the worst
     triangle around a vertex worse) and every triangle stays counter-clockwise (exact
-    orient2d).  Returns 1 if v moved."""
+    orient2d).  A vertex whose triangles are all nearly equilateral (shape > 0.985) is
+    left alone: most are, which saves most of the work.  Returns 1 if v moved."""
     cdef int e0 = T.vhe[v], e = e0, guard = 0, n = 0, u, w, k
     cdef double lx = 0.0, ly = 0.0, ix = 0.0, iy = 0.0, ax, ay, mx, my, q, worst_q = 2.0
     cdef double wx = 0.0, wy = 0.0, best, bx, by, cx, cy, t
@@ -83,6 +84,8 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
             break
         if guard > 64:
             return 0
+    if worst_q > 0.985:
+        return 0                    # all its triangles are nearly equilateral already
     best = worst_q
     bx = T.xy[2 * v]
     by = T.xy[2 * v + 1]
