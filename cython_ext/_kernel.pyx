@@ -681,3 +681,37 @@ def incircle_many(const double[:, ::1] points, const int32_t[:, ::1] quad):
             out[i] = incircle(&points[quad[i, 0], 0], &points[quad[i, 1], 0],
                               &points[quad[i, 2], 0], &points[quad[i, 3], 0])
     return out_arr
+
+
+def limit_gradation_grid(double[:, ::1] h, double dx, double dy, double rate, int rounds=2):
+    """In place: lower h so that h[p] <= h[q] + rate * |p - q| between grid neighbours
+    (8-neighbour raster sweeps, forward then backward, `rounds` times), i.e. the size
+    grows by at most `rate` per unit of length along any path of grid nodes."""
+    cdef Py_ssize_t ny = h.shape[0], nx = h.shape[1], i, j, r
+    cdef double cx = rate * dx, cy = rate * dy, cd = rate * sqrt(dx * dx + dy * dy), v
+    with nogil:
+        for r in range(rounds):
+            for j in range(ny):
+                for i in range(nx):
+                    v = h[j, i]
+                    if i > 0:
+                        v = min(v, h[j, i - 1] + cx)
+                    if j > 0:
+                        v = min(v, h[j - 1, i] + cy)
+                        if i > 0:
+                            v = min(v, h[j - 1, i - 1] + cd)
+                        if i < nx - 1:
+                            v = min(v, h[j - 1, i + 1] + cd)
+                    h[j, i] = v
+            for j in range(ny - 1, -1, -1):
+                for i in range(nx - 1, -1, -1):
+                    v = h[j, i]
+                    if i < nx - 1:
+                        v = min(v, h[j, i + 1] + cx)
+                    if j < ny - 1:
+                        v = min(v, h[j + 1, i] + cy)
+                        if i < nx - 1:
+                            v = min(v, h[j + 1, i + 1] + cd)
+                        if i > 0:
+                            v = min(v, h[j + 1, i - 1] + cd)
+                    h[j, i] = v

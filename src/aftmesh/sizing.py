@@ -14,12 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._kernel import limit_gradation_grid
 from .errors import InvalidSizeError
 
 __all__ = ["SizeField", "make_size_field"]
 
 # The background grid has at most this many nodes along its longer side.
-MAX_GRID = 1024
+MAX_GRID = 512
 DEFAULT_GRADATION = 1.3
 
 
@@ -115,24 +116,13 @@ def per_region_size(polygons, sizes):
 
 
 def limit_gradation(h: np.ndarray, dx: float, dy: float, gradation: float) -> np.ndarray:
-    """Smallest field <= h with h(x) <= h(y) + (gradation - 1) * |x - y| between grid
-    nodes (distances along rows and columns, repeated so diagonals are covered)."""
+    """Smallest field <= h with h(p) <= h(q) + (gradation - 1) * |p - q| along paths of
+    grid nodes (the kernel's 8-neighbour sweeps)."""
     if gradation <= 1.0 or h.size <= 1:
         return h
-    g = gradation - 1.0
-    h = h.copy()
-    ny, nx = h.shape
-    ix = np.arange(nx) * dx * g
-    iy = np.arange(ny) * dy * g
-    for _ in range(2):
-        if nx > 1:
-            h = np.minimum(h, np.minimum.accumulate(h - ix, axis=1) + ix)
-            h = np.minimum(h, (np.minimum.accumulate((h + ix)[:, ::-1], axis=1))[:, ::-1] - ix)
-        if ny > 1:
-            h = np.minimum(h, np.minimum.accumulate(h - iy[:, None], axis=0) + iy[:, None])
-            h = np.minimum(h, (np.minimum.accumulate((h + iy[:, None])[::-1], axis=0))[::-1]
-                           - iy[:, None])
-    return h
+    out = np.ascontiguousarray(h, dtype=np.float64).copy()
+    limit_gradation_grid(out, float(dx), float(dy), float(gradation - 1.0))
+    return out
 
 
 def _grid(bounds, spacing: float):
