@@ -33,8 +33,14 @@ def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.
         if k is not None:
             markers[k] = j
             continue
-        # a split segment: follow collinear pieces from u towards v
-        pa, pb = points[u], points[v]
+        if u < 0:
+            # walk from the end that is in the output (a segment can leave the domain
+            # through a boundary vertex; its outside part is carved away)
+            u, v, a, b = v, u, b, a
+        if u < 0:
+            continue
+        # a split segment: follow collinear pieces from u towards b's input position
+        pa, pb = in_points[a], in_points[b]
         cur, prev, guard = u, -1, 0
         while cur != v and guard <= len(points):
             guard += 1
@@ -45,7 +51,7 @@ def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.
                 pw = points[w]
                 if _kernel.py_orient2d(pa[0], pa[1], pb[0], pb[1], pw[0], pw[1]) != 0:
                     continue
-                if np.dot(pw - points[cur], pb - pa) > 0:
+                if np.dot(pw - points[cur], pb - pa) > 0 and np.dot(pb - pw, pb - pa) >= 0:
                     step = w
                     break
             if step < 0:
