@@ -232,8 +232,12 @@ def summary(results: dict) -> str:
     if "mesh" in results:
         mesh = results["mesh"]
         m = mesh.get("meta", {})
+        load = ""
+        if m.get("load_start") is not None:
+            load = f", load average {m['load_start']:.1f}-{m.get('load_end', 0):.1f}"
         out.append(f"Meshing ({'quick' if m.get('quick') else 'full'} run, {m.get('date', '?')}, "
-                   f"{m.get('machine', '')}); ratios against Triangle `pq30a` in the same run, "
+                   f"{m.get('machine', '')}{load}); ratios against Triangle `pq30a` in the same "
+                   "run (CPU ratio: of process CPU time, less sensitive to a busy machine), "
                    "RR = radius ratio 2 r_in / r_circ.")
         out.append("")
         hdr = ("| case | aftmesh triangles | aftmesh time | Triangle pq30a time | time ratio | "

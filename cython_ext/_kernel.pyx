@@ -80,6 +80,27 @@ cdef tuple _centroid(Tri* T, int t):
     return ((a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0)
 
 
+cdef bint _vertex_on_segment(Tri* T, int v) noexcept nogil:
+    cdef int e0 = T.vhe[v], e = e0
+    while True:
+        if T.eflag[e] & E_SEGMENT:
+            return True
+        e = T.twin[prv(e)]
+        if e == e0:
+            return False
+
+
+cdef int _seed_triangle(Tri* T, int loc, int where) noexcept nogil:
+    """The triangle a flood fill starts from for a seed point located at (loc, where)."""
+    if loc == LOC_IN_TRIANGLE:
+        return where
+    if loc == LOC_ON_EDGE:
+        return where // 3
+    if loc == LOC_ON_VERTEX:
+        return T.vhe[where] // 3
+    return NONE
+
+
 cdef class Triangulation:
     """A triangulation of a point set with constrained edges, held in flat arrays.
 
@@ -190,14 +211,11 @@ cdef class Triangulation:
                 if res < 0:
                     break
                 loc = locate(T, &holes[i, 0], NONE, &where)
-                if loc == LOC_IN_TRIANGLE:
-                    T.stack[0] = where
-                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
-                elif loc == LOC_ON_EDGE:
-                    T.stack[0] = where // 3
-                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
-                elif loc < 0:
+                if loc < 0:
                     res = loc
+                elif _seed_triangle(T, loc, where) >= 0:
+                    T.stack[0] = _seed_triangle(T, loc, where)
+                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
         _raise_for(T, res)
 
     def assign_regions(self, const double[:, ::1] seeds, const int32_t[::1] ids):
@@ -208,14 +226,11 @@ cdef class Triangulation:
         with nogil:
             for i in range(seeds.shape[0]):
                 loc = locate(T, &seeds[i, 0], NONE, &where)
-                if loc == LOC_IN_TRIANGLE:
-                    t = where
-                elif loc == LOC_ON_EDGE:
-                    t = where // 3
-                elif loc < 0:
+                if loc < 0:
                     res = loc
                     break
-                else:
+                t = _seed_triangle(T, loc, where)
+                if t < 0:
                     continue
                 if T.tstate[t] != T_UNMESHED:
                     continue
@@ -287,8 +302,9 @@ cdef class Triangulation:
                 T.tregion[t] = r
 
     def state_at(self, double x, double y):
-        """State of the triangle holding (x, y): 1 exterior, 2 unmeshed, 3 meshed (a
-        point on an edge reports the triangle on its left); 1 outside the hull."""
+        """State of the triangle holding (x, y): 1 exterior, 2 unmeshed, 3 meshed; 1
+        outside the hull; 0 when the point lies on a segment or on a vertex that a
+        segment ends at (it then belongs to no single region)."""
         cdef double p[2]
         cdef int where = NONE, loc
         p[0] = x
@@ -298,8 +314,12 @@ cdef class Triangulation:
         if loc == LOC_IN_TRIANGLE:
             return self.T.tstate[where]
         if loc == LOC_ON_EDGE:
+            if self.T.eflag[where] & E_SEGMENT:
+                return 0
             return self.T.tstate[where // 3]
         if loc == LOC_ON_VERTEX:
+            if _vertex_on_segment(&self.T, where):
+                return 0
             return self.T.tstate[self.T.vhe[where] // 3]
         return T_EXTERIOR
 

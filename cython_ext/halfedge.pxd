@@ -33,7 +33,7 @@ cdef enum:
     E_FIXED = 2         # a temporary constraint (F, G while Update_internal inserts them)
 
     # tstate values
-    T_FREE = 0          # slot on the free list
+    T_FREE = 0          # slot not in use (only transiently, inside a re-triangulation)
     T_EXTERIOR = 1      # ghost triangles, outside the domain, holes
     T_UNMESHED = 2      # part of the unmeshed region S(E) of the paper
     T_MESHED = 3        # part of the mesh T built so far
@@ -60,9 +60,8 @@ cdef struct Tri:
     uint8_t* eflag      # 3 per triangle
     uint8_t* tstate     # 1 per triangle
     int32_t* tregion    # 1 per triangle
-    int32_t nt, nt_cap  # slots handed out so far / allocated
-    int32_t* free_tris  # reusable slots (tstate == T_FREE)
-    int32_t nfree
+    int32_t nt, nt_cap  # slots handed out so far / allocated (no slot is ever given
+                        # back: every re-triangulation refills the slots it empties)
     int32_t last        # a live finite triangle where the next walk starts
     uint32_t rng        # xorshift state for the stochastic walk
     # scratch stacks, grown on demand, never shrunk

@@ -21,7 +21,6 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.eflag = <uint8_t*> malloc(3 * nt_cap * sizeof(uint8_t))
     T.tstate = <uint8_t*> malloc(nt_cap * sizeof(uint8_t))
     T.tregion = <int32_t*> malloc(nt_cap * sizeof(int32_t))
-    T.free_tris = <int32_t*> malloc(nt_cap * sizeof(int32_t))
     T.nt_cap = nt_cap
     T.stack_cap = 256
     T.stack = <int32_t*> malloc(T.stack_cap * sizeof(int32_t))
@@ -30,15 +29,14 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.last = NONE
     T.rng = 2463534242u
     if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
-            or T.tstate == NULL or T.tregion == NULL or T.free_tris == NULL
-            or T.stack == NULL or T.buf == NULL):
+            or T.tstate == NULL or T.tregion == NULL or T.stack == NULL or T.buf == NULL):
         return ERR_NOMEM
     return 0
 
 
 cdef void tri_free(Tri* T) noexcept nogil:
     free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag)
-    free(T.tstate); free(T.tregion); free(T.free_tris); free(T.stack); free(T.buf)
+    free(T.tstate); free(T.tregion); free(T.stack); free(T.buf)
     memset(T, 0, sizeof(Tri))
 
 
@@ -73,8 +71,7 @@ cdef int reserve_triangles(Tri* T, int n) noexcept nogil:
             _grow(<void**> &T.twin, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.eflag, 3 * cap * sizeof(uint8_t)) or
             _grow(<void**> &T.tstate, cap * sizeof(uint8_t)) or
-            _grow(<void**> &T.tregion, cap * sizeof(int32_t)) or
-            _grow(<void**> &T.free_tris, cap * sizeof(int32_t))):
+            _grow(<void**> &T.tregion, cap * sizeof(int32_t))):
         return ERR_NOMEM
     T.nt_cap = cap
     return 0
@@ -116,10 +113,7 @@ cdef int add_vertex(Tri* T, double x, double y) noexcept nogil:
 
 
 cdef int new_triangle(Tri* T) noexcept nogil:
-    """A free triangle slot (reused if possible); returns its index or ERR_NOMEM."""
-    if T.nfree > 0:
-        T.nfree -= 1
-        return T.free_tris[T.nfree]
+    """A new triangle slot; returns its index or ERR_NOMEM."""
     if reserve_triangles(T, T.nt + 1):
         return ERR_NOMEM
     T.nt += 1

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.spatial import cKDTree
-from shapely.geometry import Point, Polygon
+from shapely.geometry import LineString, Point, Polygon
 
 
 def _orient(p, q, r):
@@ -178,7 +178,6 @@ def polygon_with_holes(rng, n_outer=None, n_inner_rings=None, n_points=None, n_e
         def allowed(i, j):
             if i < first_free or j < first_free:
                 return False
-            from shapely.geometry import LineString
             return rings_geom.distance(LineString([pts[i], pts[j]])) > 1e-6
 
         segs = [tuple(s) for s in add_noncrossing_segments(

@@ -19,20 +19,33 @@ def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.
     markers = np.full(len(out_segments), -1, dtype=np.int32)
     if len(out_segments) == 0 or len(in_segments) == 0:
         return markers
+    # the common case, vectorized: an input segment that is an output segment as is
+    n = max(int(len(points)), 1)
+    out_key = np.sort(out_segments.astype(np.int64), axis=1)
+    out_key = out_key[:, 0] * n + out_key[:, 1]
+    ends = to_out[in_segments].astype(np.int64)
+    whole = (ends >= 0).all(axis=1)
+    in_key = np.sort(ends, axis=1)
+    in_key = in_key[:, 0] * n + in_key[:, 1]
+    order = np.argsort(out_key)
+    pos = np.minimum(np.searchsorted(out_key[order], in_key), len(order) - 1)
+    hit = whole & (out_key[order][pos] == in_key)
+    # later input segments win on duplicates, as in the loop below
+    markers[order[pos[hit]]] = np.flatnonzero(hit).astype(np.int32)
+    rest = np.flatnonzero(~hit)
+    if len(rest) == 0:
+        return markers
     index = {}
-    for k, (u, v) in enumerate(out_segments):
-        index[(int(u), int(v))] = k
-        index[(int(v), int(u))] = k
+    for k, (u, v) in enumerate(out_segments.tolist()):
+        index[(u, v)] = k
+        index[(v, u)] = k
     adjacency: dict[int, list[int]] = {}
     for u, v in out_segments:
         adjacency.setdefault(int(u), []).append(int(v))
         adjacency.setdefault(int(v), []).append(int(u))
-    for j, (a, b) in enumerate(in_segments):
+    for j in rest.tolist():
+        a, b = int(in_segments[j, 0]), int(in_segments[j, 1])
         u, v = int(to_out[a]), int(to_out[b])
-        k = index.get((u, v))
-        if k is not None:
-            markers[k] = j
-            continue
         if u < 0:
             # walk from the end that is in the output (a segment can leave the domain
             # through a boundary vertex; its outside part is carved away)
@@ -103,5 +116,5 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
     to_out = a["vertex_map"][built.merged]
     markers = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
     info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
-    return Mesh(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
+    return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
                 segments=a["segments"], regions=a["regions"], segment_markers=markers, info=info)

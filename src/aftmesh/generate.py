@@ -244,6 +244,6 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         "timing": {"boundary": t_boundary - t_start, "cdt": t_cdt - t_boundary,
                    "basic_aft": t_aft - t_cdt, "total": time.perf_counter() - t_start},
     }
-    return Mesh(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
+    return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
                 segments=a["segments"], regions=a["regions"], segment_markers=markers,
                 info=info)

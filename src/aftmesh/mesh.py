@@ -82,6 +82,21 @@ class Mesh:
             markers = np.full(len(self.segments), -1, dtype=np.int32)
         object.__setattr__(self, "segment_markers", _frozen(markers, np.int32).reshape(-1))
 
+    @classmethod
+    def _adopt(cls, **arrays) -> "Mesh":
+        """Build a Mesh from arrays the caller hands over (fresh, of the right dtype):
+        they are frozen in place instead of copied, which keeps the peak memory of a
+        large mesh at one copy of its arrays."""
+        mesh = object.__new__(cls)
+        dtypes = dict(points=np.float64, triangles=np.int32, neighbors=np.int32,
+                      segments=np.int32, regions=np.int32, segment_markers=np.int32)
+        for name, dtype in dtypes.items():
+            arr = np.ascontiguousarray(arrays[name], dtype=dtype)
+            arr.setflags(write=False)
+            object.__setattr__(mesh, name, arr)
+        object.__setattr__(mesh, "info", arrays.get("info", {}))
+        return mesh
+
     @property
     def n_points(self) -> int:
         return len(self.points)

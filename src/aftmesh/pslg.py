@@ -133,11 +133,16 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
             raise InvalidInputError(f"regions[{i}] = {reg[i].tolist()} is not finite")
         # Mesh.regions holds integer markers; Triangle's regional attributes may be
         # any number, so refuse rather than silently truncate one
-        frac = (reg[:, 2] != np.rint(reg[:, 2])) | (np.abs(reg[:, 2]) > 2**31 - 1)
+        frac = reg[:, 2] != np.rint(reg[:, 2])
         if frac.any():
             i = int(np.flatnonzero(frac)[0])
             raise InvalidInputError(
                 f"regions[{i}] has marker {float(reg[i, 2])!r}: region markers must be integers")
+        big = np.abs(reg[:, 2]) > 2**31 - 1
+        if big.any():
+            i = int(np.flatnonzero(big)[0])
+            raise InvalidInputError(
+                f"regions[{i}] has marker {float(reg[i, 2])!r}, out of the int32 range")
     kernel = _kernel.Triangulation(pts, nt_hint)
     try:
         merged = kernel.insert_points(brio_order(pts))
@@ -164,7 +169,12 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     kernel.carve(np.zeros((0, 2)), carve)
     for name, rows in (("holes", hole_pts), ("regions", reg[:, :2])):
         for i, (x, y) in enumerate(rows):
-            if kernel.state_at(x, y) != 2:
+            state = kernel.state_at(x, y)
+            if state == 0:
+                raise InvalidDomainError(
+                    f"{name}[{i}] = ({x:.6g}, {y:.6g}) lies on a segment, so it picks no "
+                    "single region: put it strictly inside")
+            if state != 2:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain")
     kernel.carve(hole_pts, False)
