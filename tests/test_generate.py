@@ -541,10 +541,12 @@ def test_deterministic_across_processes():
             "h = hashlib.sha256(); [h.update(np.ascontiguousarray(a).tobytes()) for a in "
             "(m.points, m.triangles, m.segments)]; print(h.hexdigest())")
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    # the child imports the same aftmesh as this process (installed or from src/)
+    package_root = os.path.dirname(os.path.dirname(os.path.abspath(aftmesh.__file__)))
     digests = set()
     for seed in ("0", "12345"):
         env = dict(os.environ, PYTHONHASHSEED=seed,
-                   PYTHONPATH=os.pathsep.join([os.path.join(here, "src"),
+                   PYTHONPATH=os.pathsep.join([package_root,
                                                os.environ.get("PYTHONPATH", "")]))
         out = subprocess.run([sys.executable, "-c", code], cwd=here, env=env,
                              capture_output=True, text=True, timeout=120)
