@@ -5,7 +5,7 @@ Three layers (see ARCHITECTURE.md): the Python package validates input and build
 result; this file is the thin ``def`` layer on typed memoryviews; the included parts
 hold the ``nogil`` kernels:
 
-* predicates.pxi     exact orient2d / incircle behind a floating-point filter
+* predicates.pxi     exact orient2d / incircle: filter, adaptive stage, exact fallback
 * triangulation.pxi  half-edge storage, flips, point location, point insertion
 * cdt.pxi            constrained edges (Cline & Renka) and flood fills
 * sizing.pxi         the compiled size field (background grid)

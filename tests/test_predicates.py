@@ -1,10 +1,13 @@
 """Exact predicates (cython_ext/predicates.pxi) against a Fraction oracle.
 
 Every check compares the public predicate, the floating-point filter (which
-may abstain but must never be wrong) and the exact stage on its own (run on
-every input, not only when the filter abstains) with an exact rational
-evaluation, and checks the predicate on every permutation of its arguments
-(the sign must follow the permutation's parity).
+may abstain but must never be wrong), the adaptive stage B (which must
+decide when every coordinate difference is exact, unless for incircle a lift
+or minor needs more than three doubles; with inexact differences orient2d's
+stage B abstains and incircle's may decide) and the exact stage C on its own
+(all run on every input, not only when the previous stage abstains) with an
+exact rational evaluation, and checks the predicate on every permutation of
+its arguments (the sign must follow the permutation's parity).
 """
 import itertools
 import math
@@ -85,6 +88,14 @@ def flat(points):
     return [coord for p in points for coord in p]
 
 
+def differences_exact(pts):
+    """Whether every coordinate difference p - pts[base] the stages use is exact
+    (base: a for orient2d, d for incircle), checked with Fractions."""
+    base = pts[0] if len(pts) == 3 else pts[3]
+    return all(Fraction(p[k] - base[k]) == Fraction(p[k]) - Fraction(base[k])
+               for p in pts for k in (0, 1))
+
+
 def check_orient(a, b, c):
     """Assert everything about orient2d(a, b, c); return the exact sign."""
     pts = (a, b, c)
@@ -92,6 +103,9 @@ def check_orient(a, b, c):
     filt, exact = _kernel._pred_py_orient2d_stages(*flat(pts))
     assert exact == expected, (pts, exact, expected)
     assert filt in (None, expected), (pts, filt, expected)
+    stage_b = _kernel.py_orient2d_stage_b(*flat(pts))
+    # With exact differences stage B never abstains.
+    assert stage_b == (expected if differences_exact(pts) else None), (pts, stage_b, expected)
     for perm in itertools.permutations(range(3)):
         got = py_orient2d(*flat(pts[i] for i in perm))
         assert got == parity(perm) * expected, (pts, perm, got, expected)
@@ -105,6 +119,16 @@ def check_incircle(a, b, c, d):
     filt, exact = _kernel._pred_py_incircle_stages(*flat(pts))
     assert exact == expected, (pts, exact, expected)
     assert filt in (None, expected), (pts, filt, expected)
+    stage_b, path = _kernel._pred_py_incircle_stage_b_path(*flat(pts))
+    assert stage_b == _kernel.py_incircle_stage_b(*flat(pts))
+    if differences_exact(pts):
+        assert path in ("sweep1", "sweeps", "grown", "split"), (pts, path)
+    else:
+        assert path in ("tails", "inexact", "split"), (pts, path)
+    if path in ("inexact", "split"):
+        assert stage_b is None, (pts, stage_b, path)
+    else:
+        assert stage_b == expected, (pts, stage_b, expected, path)
     for perm in itertools.permutations(range(4)):
         got = py_incircle(*flat(pts[i] for i in perm))
         assert got == parity(perm) * expected, (pts, perm, got, expected)
@@ -192,6 +216,7 @@ def test_error_bound_constants_are_exact():
     ccw, icc = _kernel._pred_error_bounds()
     assert Fraction(ccw) == (3 + 16 * EPS) * EPS
     assert Fraction(icc) == (10 + 96 * EPS) * EPS
+    assert Fraction(_kernel._pred_error_bound_tails()) == 48 * EPS * EPS
 
 
 # ---------------------------------------------------------------------------
@@ -465,3 +490,314 @@ def test_outside_range_does_not_crash():
         p = [rng.choice(nasty + [rng.uniform(-1, 1)]) for _ in range(8)]
         assert py_orient2d(*p[:6]) in (-1, 0, 1)
         assert py_incircle(*p) in (-1, 0, 1)
+
+
+# ---------------------------------------------------------------------------
+# Stage B: exact coordinate differences (the common case for nearby points)
+# ---------------------------------------------------------------------------
+
+STAGE_B_DECIDED = ("sweep1", "sweeps", "grown")
+
+
+def check_incircle_stage_b(pts):
+    """check_incircle, and stage B (exact differences) must decide on its own."""
+    expected = check_incircle(*pts)
+    verdict, path = _kernel._pred_py_incircle_stage_b_path(*flat(pts))
+    assert path in STAGE_B_DECIDED and verdict == expected, (pts, verdict, path, expected)
+    return expected
+
+
+@st.composite
+def equilateral_hexagon(draw):
+    """Four of the six neighbours of a point of an equilateral lattice (spacing h,
+    any rotation) near (0.3, 0.7), each coordinate rounded: cocircular before
+    rounding, so the determinant is tiny (or 0)."""
+    cx = draw(st.floats(0.26, 0.45))
+    cy = draw(st.floats(0.55, 0.95))
+    h = draw(st.floats(1e-4, 0.05))
+    t0 = draw(st.floats(0.0, math.pi))
+    ks = draw(st.permutations(range(6)))[:4]
+    return [(cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
+            for k in ks]
+
+
+@st.composite
+def lattice_hexagon(draw):
+    """The same for lattice points o + i*e1 + j*e2 computed in floating point.
+    (All coordinates stay within [0.14, 0.56] x [0.44, 0.86] and the four
+    points within 2h of each other, so every difference is exact by Sterbenz.)"""
+    ox = draw(st.floats(0.3, 0.4))
+    oy = draw(st.floats(0.6, 0.7))
+    h = draw(st.floats(1e-3, 0.01))
+    t = draw(st.floats(0.0, math.pi))
+    e1 = (h * math.cos(t), h * math.sin(t))
+    e2 = (h * math.cos(t + math.pi / 3), h * math.sin(t + math.pi / 3))
+    i = draw(st.integers(1, 8))
+    j = draw(st.integers(1, 8))
+    nb = [(i + 1, j), (i, j + 1), (i - 1, j + 1), (i - 1, j), (i, j - 1), (i + 1, j - 1)]
+    ks = draw(st.permutations(range(6)))[:4]
+    return [(ox + nb[k][0] * e1[0] + nb[k][1] * e2[0], oy + nb[k][0] * e1[1] + nb[k][1] * e2[1])
+            for k in ks]
+
+
+@st.composite
+def small_circle(draw):
+    """Points on a circle of radius 1e-6 .. 0.05 near (0.3, 0.7), moved by a few
+    ulps (coordinates within a factor 2 of each other: exact differences)."""
+    cx = draw(st.floats(0.29, 0.31))
+    cy = draw(st.floats(0.69, 0.71))
+    r = 10.0 ** draw(st.floats(-6.0, -1.3))
+    pts = []
+    for _ in range(4):
+        theta = draw(st.floats(0.0, 2 * math.pi))
+        pts.append((nudge(cx + r * math.cos(theta), draw(ulps)),
+                    nudge(cy + r * math.sin(theta), draw(ulps))))
+    return pts
+
+
+@PROFILE
+@given(equilateral_hexagon())
+def test_stage_b_equilateral_hexagon(pts):
+    check_incircle_stage_b(pts)
+
+
+@PROFILE
+@given(lattice_hexagon())
+def test_stage_b_lattice_hexagon(pts):
+    check_incircle_stage_b(pts)
+
+
+@PROFILE
+@given(small_circle())
+def test_stage_b_small_circles(pts):
+    check_incircle_stage_b(pts)
+
+
+@PROFILE
+@given(equilateral_hexagon(), st.integers(INCIRCLE_EXP[0] + 2, INCIRCLE_EXP[1] - 2))
+def test_stage_b_hexagon_scaled_to_range_ends(pts, e):
+    # Scaling by 2^e is exact and keeps every difference exact.
+    s = 2.0**e
+    check_incircle_stage_b([(x * s, y * s) for x, y in pts])
+
+
+@PROFILE
+@given(st.sampled_from([CIRCLE_5, CIRCLE_65]).flatmap(
+           lambda pts: st.permutations(pts).map(lambda p: p[:4])),
+       st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
+       st.integers(-120, 120))
+def test_stage_b_integer_circles_scaled(pts, ox, oy, e):
+    # Exactly cocircular; the differences (x - x') * 2^e are exact.
+    s = 2.0**e
+    moved = [((x + ox) * s, (y + oy) * s) for x, y in pts]
+    assert check_incircle_stage_b(moved) == 0
+
+
+@PROFILE
+@given(st.floats(0.25, 0.5), st.floats(0.25, 0.5), st.floats(0.5, 1.0), st.floats(0.5, 1.0),
+       st.permutations(range(4)), st.integers(-150, 200))
+def test_stage_b_rectangles(x1, x2, y1, y2, order, e):
+    # Corners of an axis-aligned rectangle are exactly cocircular, whatever
+    # the doubles; full-width coordinates make the zero hard to see (several
+    # sweeps, sometimes growing).
+    s = 2.0**e
+    corners = [(x1 * s, y1 * s), (x2 * s, y1 * s), (x2 * s, y2 * s), (x1 * s, y2 * s)]
+    assert check_incircle_stage_b([corners[i] for i in order]) == 0
+
+
+def test_stage_b_pinned_grown_path():
+    # A scaled rectangle whose zero determinant the certificate does not see
+    # within the sweeps: decided by growing the components.
+    pts = [(-6.479526483929613e-14, -1.901272885017952e-15),
+           (-2.4760177410006713e-14, -4.019328122107341e-14),
+           (-6.479526483929613e-14, -4.019328122107341e-14),
+           (-2.4760177410006713e-14, -1.901272885017952e-15)]
+    assert _kernel._pred_py_incircle_stage_b_path(*flat(pts)) == (0, "grown")
+    assert check_incircle_stage_b(pts) == 0
+
+
+def test_stage_b_decides_the_lattice_cases_the_filter_leaves():
+    # The point of stage B: nearly every input the filter cannot decide, on
+    # rounded lattices and circles, is decided by stage B (stage C unused).
+    rng = random.Random(20240917)
+    undecided = 0
+    for _ in range(2000):
+        cx, cy = rng.uniform(0.26, 0.45), rng.uniform(0.55, 0.95)
+        h, t0 = rng.uniform(1e-3, 0.02), rng.uniform(0, math.pi)
+        ks = rng.sample(range(6), 4)
+        pts = [(cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
+               for k in ks]
+        filt, _ = _kernel._pred_py_incircle_stages(*flat(pts))
+        if filt is None:
+            undecided += 1
+            verdict, path = _kernel._pred_py_incircle_stage_b_path(*flat(pts))
+            assert path in STAGE_B_DECIDED and verdict == incircle_oracle(*pts), (pts, path)
+    assert undecided > 500
+
+
+# Inexact differences: incircle's stage B decides with the tail bound (T) or
+# abstains; stage C decides.
+
+@PROFILE
+@given(points_of(coords((-80, -60))), points_of(coords((-2, 2))),
+       points_of(coords((-80, -60))), points_of(coords((-2, 2))))
+def test_stage_b_inexact_differences(a, b, c, d):
+    # Coordinates near 1 against coordinates near 1e-20: a difference like
+    # 1.0 - 1e-20 is not a double.  check_incircle / check_orient assert
+    # that stage B is right or abstains, and that orient2d's abstains.
+    assume(not differences_exact((a, b, c, d)))
+    check_incircle(a, b, c, d)
+    assert _kernel._pred_py_incircle_stage_b_path(*flat((a, b, c, d)))[1] in (
+        "tails", "inexact", "split")
+    check_orient(d, a, b)
+    check_orient(a, c, d)
+
+
+@st.composite
+def diagonal_trapezoid(draw):
+    """Like the boundary layer of a mesh of the unit square: (s, 0), (0, s),
+    (u, r), (r', u) with s, u on a grid of step h, r = h sqrt(3)/2 and r' = r
+    moved by a few ulps (the mesher computes the two sides differently).
+    Nearly symmetric about the diagonal, so nearly cocircular (exactly, if
+    r' == r); far apart and near the axes, so most differences are inexact."""
+    h = draw(st.sampled_from([0.01, 0.005, 0.0025, 0.001]))
+    n = int(round(1 / h))
+    s = draw(st.integers(1, n)) * h
+    u = draw(st.integers(1, n)) * h
+    r = h * math.sqrt(3) / 2
+    pts = [(s, 0.0), (0.0, s), (u, r), (nudge(r, draw(ulps)), u)]
+    return [pts[i] for i in draw(st.permutations(range(4)))]
+
+
+@PROFILE
+@given(diagonal_trapezoid())
+def test_stage_b_inexact_differences_large_configurations(pts):
+    check_incircle(*pts)
+
+
+def test_stage_b_tails_decide_large_configurations():
+    # With r' != r these are not cocircular; the filter leaves all of them,
+    # and stage B decides nearly all with the tail bound (T).
+    rng = random.Random(5)
+    undecided = tails = 0
+    for _ in range(1500):
+        h = rng.choice([0.01, 0.005, 0.0025])
+        n = int(round(1 / h))
+        s, u, r = rng.randint(1, n) * h, rng.randint(1, n) * h, h * math.sqrt(3) / 2
+        pts = [(s, 0.0), (0.0, s), (u, r), (nudge(r, rng.choice([-2, -1, 1, 2])), u)]
+        rng.shuffle(pts)
+        if _kernel._pred_py_incircle_stages(*flat(pts))[0] is None:
+            undecided += 1
+            verdict, path = _kernel._pred_py_incircle_stage_b_path(*flat(pts))
+            if path == "tails":
+                tails += 1
+                assert verdict == incircle_oracle(*pts), pts
+    assert undecided > 300 and tails > 0.9 * undecided, (undecided, tails)
+
+
+def test_stage_b_tails_pinned_mesh_inputs():
+    # Met in a mesh of the unit square (h = 0.0025), left by the filter.
+    for r in ([0.1825, 0.0, 0.00216506350946108, 0.15375, 0.15375, 0.0021650635094610958,
+               0.0, 0.1825],
+              [0.002165063509461112, 0.38125, 0.38625, 0.0021650635094610958,
+               0.002165063509461112, 0.38625, 0.38125, 0.0021650635094610958],
+              [0.31875, 0.9978349364905389, 0.002165063509461112, 0.70875,
+               0.00216506350946108, 0.6812499999999999, 0.29125, 0.9978349364905389]):
+        pts = [(r[2 * i], r[2 * i + 1]) for i in range(4)]
+        assert _kernel._pred_py_incircle_stages(*r)[0] is None
+        assert _kernel._pred_py_incircle_stage_b_path(*r) == (incircle_oracle(*pts), "tails")
+        check_incircle(*pts)
+
+
+@PROFILE
+@given(st.floats(-0.5, -0.25), st.floats(0.25, 1.0), st.floats(-0.5, -0.25), st.floats(0.25, 1.0),
+       st.permutations(range(4)))
+def test_stage_b_inexact_differences_zero_determinant(x1, x2, y1, y2, order):
+    # A rectangle straddling both axes: exactly cocircular, differences
+    # mostly inexact.  No bound can show a zero: stage B must abstain (or,
+    # if all differences happen to be exact, decide 0), and stage C gives 0.
+    corners = [(x1, y1), (x2, y1), (x2, y2), (x1, y2)]
+    pts = [corners[i] for i in order]
+    assert check_incircle(*pts) == 0
+    verdict, path = _kernel._pred_py_incircle_stage_b_path(*flat(pts))
+    assert verdict in (None, 0) and path != "tails", (pts, verdict, path)
+
+
+def test_stage_b_near_origin_all_paths_agree():
+    # Nearly cocircular points around the origin: differences of coordinates
+    # of opposite signs are sums, often inexact.
+    rng = random.Random(99)
+    inexact = 0
+    for _ in range(400):
+        r = rng.uniform(1e-3, 1.0)
+        pts = [(r * math.cos(t), r * math.sin(t))
+               for t in (rng.uniform(0, 2 * math.pi) for _ in range(4))]
+        check_incircle(*pts)
+        inexact += not differences_exact(pts)
+    assert inexact > 100
+
+
+@PROFILE
+@given(st.floats(0.5, 1.0), st.floats(0.5, 1.0), st.floats(0.5, 1.0), st.floats(0.5, 1.0),
+       st.integers(-140, -100), points_of(coords((-10, 10))))
+def test_stage_b_split_abstains(x1, y1, x2, y2, e, a):
+    # d at the origin makes every difference exact, but a minor
+    # bdx*cdy - cdx*bdy with bdx, cdy ~ 1 and cdx, bdy ~ 2^e spans far more
+    # than 158 bits: stage B cannot split it and abstains ('split' path,
+    # allowed by check_incircle); stage C decides.
+    s = 2.0**e
+    b, c, d = (x1, y1 * s), (x2 * s, y2), (0.0, 0.0)
+    check_incircle(a, b, c, d)
+
+
+def test_stage_b_split_example():
+    pts = [(0.75, 0.3), (0.7654321, 0.8765432 * 2.0**-120), (0.6789012 * 2.0**-120, 0.5432109),
+           (0.0, 0.0)]
+    assert _kernel._pred_py_incircle_stage_b_path(*flat(pts)) == (None, "split")
+    check_incircle(*pts)
+
+
+# orient2d's stage B.
+
+@PROFILE
+@given(near_collinear(points_of(st.floats(min_value=0.26, max_value=0.49))))
+def test_orient_stage_b_nearly_collinear(abc):
+    # All coordinates in one binade: every difference is exact (Sterbenz), so
+    # stage B decides (check_orient asserts it).
+    assume(all(0.25 <= v < 0.5 for v in flat(abc)))
+    assert differences_exact(abc)
+    check_orient(*abc)
+
+
+# The sign readers of stage B on their own.
+
+@st.composite
+def cancelling_doubles(draw):
+    """Up to 54 doubles of very different magnitudes whose sum nearly cancels:
+    random values, some repeated with the opposite sign and moved by ulps."""
+    base = draw(st.lists(st.floats(min_value=0.5, max_value=1.0), min_size=1, max_size=20))
+    vals = [draw(st.sampled_from([1.0, -1.0])) * v * 2.0**draw(st.integers(-200, 200))
+            for v in base]
+    back = draw(st.lists(st.sampled_from(range(len(vals))), max_size=27))
+    vals += [nudge(-vals[i], draw(st.integers(-2, 2))) for i in back]
+    vals = vals[:54]
+    return draw(st.permutations(vals))
+
+
+@PROFILE
+@given(cancelling_doubles(), st.integers(1, 4))
+def test_stage_b_sign_readers(vals, sweeps):
+    exact = sum(Fraction(v) for v in vals)
+    cert, swept, grown = _kernel._pred_py_sum_sign(vals, sweeps)
+    assert sum(Fraction(v) for v in swept) == exact      # sweeps keep the sum
+    assert cert in (None, sign(exact)), (vals, cert)
+    assert grown == sign(exact), (vals, grown)
+
+
+def test_stage_b_sign_readers_examples():
+    assert _kernel._pred_py_sum_sign([1.0, -1.0, 1e-30], 1)[0] == 1
+    # One sweep leaves 1e-16 below a zero top: not certified, a second sweep is.
+    assert _kernel._pred_py_sum_sign([1.0, 1e-16, -1.0], 1)[0] is None
+    assert _kernel._pred_py_sum_sign([1.0, 1e-16, -1.0], 2)[0] == 1
+    assert _kernel._pred_py_sum_sign([0.0, 0.0], 1)[0] == 0
+    assert _kernel._pred_py_sum_sign([2.0**-1000, -(2.0**-1000)], 1)[0] == 0
