@@ -15,6 +15,7 @@ Every kernel routine returns a status code (0 or a count on success, a negative 
 from halfedge.pxd on failure); the methods here turn codes into exceptions.
 """
 from halfedge cimport *
+from cpython.ref cimport Py_XDECREF
 
 import numpy as np
 
@@ -48,6 +49,20 @@ class CrossingError(ValueError):
 
 class CollinearError(ValueError):
     """All points lie on one line, so they have no triangulation."""
+
+
+cdef int _reraise_pending(Aft* A) except -1:
+    """Raise again the exception a signal handler raised inside a nogil loop."""
+    cdef PyObject* t = A.exc_type
+    cdef PyObject* v = A.exc_value
+    cdef PyObject* tb = A.exc_tb
+    A.exc_type = NULL
+    A.exc_value = NULL
+    A.exc_tb = NULL
+    if t == NULL:
+        return 0
+    PyErr_Restore(t, v, tb)     # steals the three references
+    return -1
 
 
 cdef object _raise_for(Tri* T, int code):
@@ -125,6 +140,10 @@ cdef class Triangulation:
                 add_vertex(&self.T, points[i, 0], points[i, 1])
 
     def __dealloc__(self):
+        # an exception kept from a signal handler but never raised: drop it
+        Py_XDECREF(self.A.exc_type)
+        Py_XDECREF(self.A.exc_value)
+        Py_XDECREF(self.A.exc_tb)
         aft_free(&self.A)
         tri_free(&self.T)
 
@@ -608,6 +627,7 @@ cdef class Triangulation:
         finally:
             self.A.progress = NULL
             self.progress = None
+        _reraise_pending(&self.A)
         _raise_for(&self.T, res)
         if DEBUG:
             problems = self.validate()
@@ -619,7 +639,8 @@ cdef class Triangulation:
         rounds, each followed by Delaunay flips; returns the number of moves."""
         cdef int res
         with nogil:
-            res = smooth(&self.T, first_movable, passes)
+            res = smooth(&self.A, &self.T, first_movable, passes)
+        _reraise_pending(&self.A)
         _raise_for(&self.T, res)
         return res
 

@@ -16,11 +16,15 @@
 
 from libc.math cimport sqrt, floor, log2
 
+from cpython.ref cimport PyObject
+
 cdef extern from "Python.h":
     # declared here without Cython's "except -1" so that the compiled loop can turn a
-    # pending Ctrl-C into a status code instead of an exception inside a nogil routine
+    # pending signal into a status code instead of an exception inside a nogil routine
     int PyErr_CheckSignals()
     void PyErr_Clear()
+    void PyErr_Fetch(PyObject** ptype, PyObject** pvalue, PyObject** ptraceback)
+    void PyErr_Restore(PyObject* ptype, PyObject* pvalue, PyObject* ptraceback)
 
 cdef enum:
     ORDER_SHORTEST = 0
@@ -59,6 +63,11 @@ cdef struct Aft:
     # reference kept alive by the owning Triangulation) every few thousand steps
     double area_total, area_meshed
     void* progress
+    # the exception a signal handler raised (Ctrl-C's KeyboardInterrupt, a watchdog's
+    # own exception), held here until the def layer can raise it again
+    PyObject* exc_type
+    PyObject* exc_value
+    PyObject* exc_tb
 
 
 cdef int aft_init(Aft* A) noexcept nogil:
@@ -564,6 +573,19 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
     return add_triangle(A, T, t)
 
 
+cdef int check_signals(Aft* A) noexcept nogil:
+    """Run Python's signal handlers; if one raised, keep its exception in A (the def
+    layer raises it again) and return ERR_INTERRUPTED."""
+    with gil:
+        if PyErr_CheckSignals() != 0:
+            if A.exc_type == NULL:
+                PyErr_Fetch(&A.exc_type, &A.exc_value, &A.exc_tb)
+            else:
+                PyErr_Clear()
+            return ERR_INTERRUPTED
+    return 0
+
+
 cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
     """Figure 5, compiled: runs without the GIL and takes it back only every few
     thousand steps to let Ctrl-C through and to report progress."""
@@ -578,10 +600,9 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
             return res
         count += 1
         if count % 8192 == 0:
+            if check_signals(A) != 0:
+                return ERR_INTERRUPTED
             with gil:
-                if PyErr_CheckSignals() != 0:
-                    PyErr_Clear()
-                    return ERR_INTERRUPTED
                 if A.progress != NULL and A.area_total > 0:
                     try:
                         (<object> A.progress)(A.area_meshed / A.area_total)

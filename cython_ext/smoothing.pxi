@@ -120,13 +120,20 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
             return 1
 
 
-cdef int smooth(Tri* T, int first_movable, int passes) noexcept nogil:
-    """`passes` rounds of smoothing of vertices first_movable.. and Delaunay flips.
-    Returns the number of vertex moves, or an error."""
-    cdef int p, v, t, k, n, res, moved = 0
+cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
+    """Up to `passes` rounds of smoothing of vertices first_movable.. and Delaunay
+    flips, stopping early when a round moves nothing; signals are checked after each
+    round.  Returns the number of vertex moves, or an error."""
+    cdef int p, v, t, k, n, res, moved = 0, moved_now
     for p in range(passes):
+        moved_now = 0
         for v in range(first_movable, T.nv):
-            moved += _smooth_vertex(T, v)
+            moved_now += _smooth_vertex(T, v)
+        moved += moved_now
+        if check_signals(A) != 0:
+            return ERR_INTERRUPTED
+        if moved_now == 0:
+            break
         if reserve_stack(T, 3 * T.nt):
             return ERR_NOMEM
         n = 0

@@ -16,8 +16,11 @@ _SAMPLES = 32  # points per segment at which the size is read to integrate 1/h
 
 
 def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
-               field: SizeField):
-    """Return (vertices, segments, source) with long segments split by the size."""
+               field: SizeField, max_pieces: int | None = None):
+    """Return (vertices, segments, source) with long segments split by the size.
+
+    Raises InvalidSizeError, before allocating anything, if the boundary alone would
+    need more than `max_pieces` edges (each is a side of a triangle of the mesh)."""
     if len(segments) == 0:
         return vertices, segments, source
     a = vertices[segments[:, 0]]
@@ -26,10 +29,25 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     s = np.linspace(0.0, 1.0, _SAMPLES)
     xs = a[:, None, 0] + (b - a)[:, None, 0] * s
     ys = a[:, None, 1] + (b - a)[:, None, 1] * s
-    inv_h = 1.0 / field(xs, ys)
-    # cumulative integral of 1/h along each segment (trapezoid rule), in units of h
-    steps = 0.5 * (inv_h[:, 1:] + inv_h[:, :-1]) * (length[:, None] / (_SAMPLES - 1))
+    h = field(xs, ys)
+    # cumulative integral of 1/h along each segment, h taken linear between samples:
+    # the exact integral of 1/h on such a piece is ds * ln(h1/h0) / (h1 - h0) (the
+    # trapezoid rule overcounts enormously next to a tiny size, where h varies by
+    # orders of magnitude within one sample interval)
+    ds = length[:, None] / (_SAMPLES - 1)
+    h0 = h[:, :-1]
+    h1 = h[:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_mean = np.where(np.abs(h1 - h0) > 1e-9 * h0, (np.log(h1) - np.log(h0)) / (h1 - h0),
+                            2.0 / (h0 + h1))
+    steps = ds * log_mean
     cum = np.concatenate([np.zeros((len(segments), 1)), np.cumsum(steps, axis=1)], axis=1)
+    total = float(np.rint(cum[:, -1]).clip(min=1).sum())
+    if max_pieces is not None and not total <= max_pieces:
+        from .errors import InvalidSizeError
+        raise InvalidSizeError(
+            f"the boundary alone needs about {total:.3g} edges at this size, more than "
+            f"the {max_pieces} triangles allowed")
     pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
     new_vertices = [vertices]
     new_segments = []

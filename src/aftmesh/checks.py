@@ -101,7 +101,8 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
     pos = np.minimum(pos, len(sorted_keys) - 1)
     found = sorted_keys[pos] == rev.ravel()
     other = np.where(found, order[pos] // 3, -1).reshape(t, 3)
-    if not np.array_equal(other, N):
+    neighbors_ok = np.array_equal(other, N)
+    if not neighbors_ok:
         bad = np.argwhere(other != N)[0]
         problems.append(f"neighbors[{bad[0]}, {bad[1]}] = {N[bad[0], bad[1]]}, "
                         f"the shared edge says {other[bad[0], bad[1]]}")
@@ -135,6 +136,8 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         problems.extend(_check_cover(P, S, np.asarray(input_segments, dtype=np.float64)))
     # constrained Delaunay: the apex across every non-segment interior edge
     if delaunay:
+        # the shared edges found above, not `neighbors`, which may be what is broken
+        N = other
         interior = found.reshape(t, 3)
         ti, k = np.nonzero(interior)
         is_seg = np.fromiter(((int(a[i, j]), int(b[i, j])) in seg_keys for i, j in zip(ti, k)),

@@ -26,7 +26,7 @@ from shapely.geometry import (GeometryCollection, LineString, MultiLineString, M
                               MultiPolygon, Point, Polygon)
 
 from .errors import InvalidDomainError, InvalidInputError
-from .pslg import as_points, as_segments
+from .pslg import as_points, as_segments, check_range
 
 __all__ = ["Domain", "to_domain"]
 
@@ -201,13 +201,30 @@ def _merge_and_node(verts, segs, src, note):
     pairs = pairs[:, pairs[0] < pairs[1]]
     if pairs.shape[1] == 0:
         return uniq, segs, src
+    # cut both segments of each crossing pair at the computed crossing point; it is
+    # rounded, so it is not exactly on either segment, but within an ulp of both, and
+    # the two pieces of each segment bend by that much at most
+    base = len(uniq)
     extra = []
+    cuts: dict[int, list[int]] = {}
     for i, j in pairs.T:
         for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
             if isinstance(p, Point):
                 extra.append(np.asarray(p.coords)[0, :2])
+                cuts.setdefault(int(i), []).append(base + len(extra) - 1)
+                cuts.setdefault(int(j), []).append(base + len(extra) - 1)
     note.append(f"split segments at {pairs.shape[1]} crossings")
     verts = np.concatenate([uniq, np.array(extra).reshape(-1, 2)])
+    out_s, out_src = [], []
+    for k in range(len(segs)):
+        a, b = segs[k]
+        inner = sorted(set(cuts.get(k, ())),
+                       key=lambda v: float(np.dot(verts[v] - verts[a], verts[b] - verts[a])))
+        chain = [a, *inner, b]
+        out_s.append(np.c_[chain[:-1], chain[1:]])
+        out_src.append([src[k]] * (len(chain) - 1))
+    segs = np.concatenate(out_s)
+    src = np.concatenate([np.asarray(x) for x in out_src])
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
     segs, src = _split_at_vertices(uniq, segs, src, None)
@@ -283,19 +300,52 @@ def _from_dict(d: dict) -> Domain:
     markers = d.get("segment_markers")
     src = np.arange(len(seg), dtype=np.int32)
     if markers is not None:
-        markers = np.asarray(markers).reshape(-1)
+        try:
+            markers = np.asarray(markers).reshape(-1)
+        except (ValueError, TypeError) as exc:
+            raise InvalidInputError(f"segment_markers must be a list of integers: {exc}") from None
         if len(markers) != len(seg):
             raise InvalidInputError(
                 f"segment_markers has {len(markers)} entries for {len(seg)} segments")
         if not np.issubdtype(markers.dtype, np.integer):
             raise InvalidInputError("segment_markers must be integers")
+        big = np.abs(markers.astype(np.int64)) > 2**31 - 1
+        if big.any():
+            i = int(np.flatnonzero(big)[0])
+            raise InvalidInputError(
+                f"segment_markers[{i}] = {int(markers[i])} is out of the int32 range")
         markers = markers.astype(np.int32)
+    _refuse_crossings(pts, seg)
     return Domain(pts, seg, src, [f"segments[{i}]" for i in range(len(seg))],
                   holes=holes, region_points=reg, source_markers=markers)
 
 
+def _refuse_crossings(pts, seg):
+    """Dict / .poly input: segments crossing at a point inside both are refused (the
+    policy of aftmesh.cdt), before any size-dependent splitting could hide them."""
+    if len(seg) < 2:
+        return
+    lines = shapely.linestrings(np.stack([pts[seg[:, 0]], pts[seg[:, 1]]], axis=1))
+    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
+    pairs = pairs[:, pairs[0] < pairs[1]]
+    if pairs.shape[1]:
+        from .errors import CrossingSegmentsError
+        i, j = (int(x) for x in pairs[:, 0])
+        raise CrossingSegmentsError(
+            f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
+            f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
+            f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})", (i, j))
+
+
 def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
     """Convert any accepted domain form into a :class:`Domain` (see module doc)."""
+    dom = _to_domain(domain, keep_vertices)
+    if len(dom.vertices):
+        check_range(dom.vertices, "vertices")
+    return dom
+
+
+def _to_domain(domain, keep_vertices: bool) -> Domain:
     if isinstance(domain, (str, PathLike)):
         from .io import read_poly
         try:
@@ -325,7 +375,10 @@ def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
             _check_polygon(p, names[k])
         union = shapely.union_all(polygons)
         for k, line in enumerate(lines):
-            if not union.buffer(1e-12 * max(1.0, union.length)).covers(line):
+            # covered, or outside by no more than rounding (a line ending on the
+            # boundary at a rounded point)
+            if not (union.covers(line)
+                    or line.difference(union).length <= 1e-9 * max(line.length, 1e-300)):
                 raise InvalidDomainError(f"constraint line {k} is not inside the domain")
         for k, p in enumerate(points):
             if not union.covers(p):
@@ -344,7 +397,10 @@ def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
             raise InvalidDomainError(f"vertex {i} = {arr[i].tolist()} is not finite")
         if len(arr) < 3:
             raise InvalidDomainError(f"a polygon ring needs at least 3 vertices, got {len(arr)}")
-        poly = Polygon(arr)
+        try:
+            poly = Polygon(arr)
+        except (ValueError, TypeError) as exc:
+            raise InvalidDomainError(f"the ring is not a polygon: {exc}") from None
         _check_polygon(poly, "the polygon")
         return _from_shapely([poly], [], [], ["the polygon"], keep_vertices)
     try:
@@ -360,7 +416,10 @@ def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
         if isinstance(item, shapely.Geometry):
             poly = item
         elif _is_coordinate_array(item):
-            poly = Polygon(np.asarray(item, dtype=np.float64))
+            try:
+                poly = Polygon(np.asarray(item, dtype=np.float64))
+            except (ValueError, TypeError) as exc:
+                raise InvalidDomainError(f"region {k} is not a polygon ring: {exc}") from None
         else:
             raise InvalidDomainError(f"region {k} is a {type(item).__name__}, expected a polygon")
         for part in _polygon_parts(poly, f"region {k}"):

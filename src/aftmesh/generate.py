@@ -20,6 +20,9 @@ from .sizing import DEFAULT_GRADATION, make_size_field, per_region_size
 __all__ = ["generate"]
 
 _ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
+MAX_SMOOTH = 1000           # smoothing rounds; it stops earlier once nothing moves
+# Kernel indices are int32: refuse a request for more triangles than that can number
+MAX_TRIANGLES = 2 ** 30
 
 
 class _ProgressBar:
@@ -51,11 +54,43 @@ def _progress_callback(progress, expected_triangles: int):
     return _ProgressBar(sys.stderr) if progress else None
 
 
-def _check_options(order, max_triangles, min_area, close_factor, flags):
+def _expected_triangles(field, area: float, gradation: float) -> float:
+    """About how many triangles the size field asks for on `area` (an equilateral
+    triangle of side h has area 0.43 h^2).  On a grid, a node's cell is counted at most
+    as a graded disk around a tiny size would be (the count around a point where h
+    grows linearly from h0 is only logarithmic in 1/h0), so one tiny feature does not
+    make the estimate explode."""
+    with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+        if field.h.size == 1:
+            return float(np.float64(area) / (0.43 * np.float64(field.h_min)) / field.h_min)
+        h = field.h
+        rate = max(gradation - 1.0, 0.05)
+        cell = field.dx * field.dy
+        dense = cell / (0.43 * h) / h
+        graded = (2 * np.pi / (0.43 * rate * rate)) * (
+            1.0 + np.log1p(rate * max(field.dx, field.dy) / h))
+        grid_area = cell * h.size
+        return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area) * 1.2)
+
+
+def _real(name, value, error=InvalidOptionError) -> float:
+    """A finite real number from an option value, or an error naming the option."""
+    if isinstance(value, (bool, np.bool_)) or isinstance(value, (str, bytes)):
+        raise error(f"{name} must be a number, got {value!r}")
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be a number, got {value!r}") from None
+    if not np.isfinite(out):
+        raise error(f"{name} must be finite, got {value!r}")
+    return out
+
+
+def _check_options(order, max_triangles, min_area, close_factor, smooth, strategy, flags):
     for name, value in flags.items():
         if not isinstance(value, (bool, np.bool_)):
             raise InvalidOptionError(f"{name} must be True or False, got {value!r}")
-    if order not in _ORDERS:
+    if not isinstance(order, str) or order not in _ORDERS:
         raise InvalidOptionError(
             f"order={order!r} is not a valid option, must be one of {sorted(_ORDERS)}")
     if max_triangles is not None:
@@ -63,10 +98,17 @@ def _check_options(order, max_triangles, min_area, close_factor, flags):
             raise InvalidOptionError(f"max_triangles must be an integer, got {max_triangles!r}")
         if max_triangles < 1:
             raise InvalidOptionError(f"max_triangles must be positive, got {max_triangles}")
-    if min_area is not None and not (np.isfinite(min_area) and min_area >= 0):
-        raise InvalidOptionError(f"min_area must be a finite number >= 0, got {min_area!r}")
-    if not (np.isfinite(close_factor) and 0 <= close_factor < 2):
+    if min_area is not None and _real("min_area", min_area) < 0:
+        raise InvalidOptionError(f"min_area must be >= 0, got {min_area!r}")
+    if not 0 <= _real("close_factor", close_factor) < 2:
         raise InvalidOptionError(f"close_factor must be in [0, 2), got {close_factor!r}")
+    if isinstance(smooth, (bool, np.bool_)) or not isinstance(smooth, (int, np.integer)) \
+            or not 0 <= smooth <= MAX_SMOOTH:
+        raise InvalidOptionError(
+            f"smooth must be a number of rounds from 0 to {MAX_SMOOTH}, got {smooth!r}")
+    if strategy is not None and not isinstance(strategy, Strategy):
+        raise InvalidOptionError(
+            f"strategy must be an aftmesh.aft.Strategy (or a subclass), got {strategy!r}")
 
 
 def generate(domain, size=None, *, max_triangles: int | None = None,
@@ -140,8 +182,13 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     True
     """
     t_start = time.perf_counter()
-    _check_options(order, max_triangles, min_area, close_factor,
+    _check_options(order, max_triangles, min_area, close_factor, smooth, strategy,
                    dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary))
+    gradation = _real("gradation", gradation, InvalidSizeError)
+    if max_triangles is not None:
+        max_triangles = min(int(max_triangles), MAX_TRIANGLES)
+    if isinstance(size, np.ndarray) and size.ndim == 0:
+        size = size.item()
     dom = to_domain(domain, keep_vertices=not split_boundary)
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
@@ -162,13 +209,21 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         field = make_size_field(size, (lo, hi), dom.vertices[used], shortest[used], gradation)
     else:
         field = make_size_field(size, (lo, hi), gradation=gradation)
+    area_hint = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
+    expected = _expected_triangles(field, area_hint, gradation)
+    if not expected <= MAX_TRIANGLES:
+        raise InvalidSizeError(
+            f"the size (down to {field.h_min:.3g}) asks for about {expected:.3g} triangles "
+            f"on a domain of area {area_hint:.3g}: more than the {MAX_TRIANGLES} aftmesh "
+            "can number")
     if split_boundary:
-        verts, segs, src = discretize(dom.vertices, dom.segments, dom.segment_source, field)
+        cap = MAX_TRIANGLES if max_triangles is None else max_triangles
+        verts, segs, src = discretize(dom.vertices, dom.segments, dom.segment_source, field,
+                                      max_pieces=cap)
     else:
         verts, segs, src = dom.vertices, dom.segments, dom.segment_source
     t_boundary = time.perf_counter()
-    area_hint = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
-    nt_hint = int(min(4e8, 2.5 * area_hint / (0.43 * field.h_min ** 2) + 4 * len(verts)))
+    nt_hint = int(min(4e8, expected + 4 * len(verts)))
     try:
         built = build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
                           nt_hint=min(nt_hint, 50_000_000))
@@ -219,8 +274,6 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
                 "the strategy's get_next_edge returned -1 while front edges remained")
     moves = 0
     if smooth:
-        if isinstance(smooth, bool) or not isinstance(smooth, (int, np.integer)) or smooth < 0:
-            raise InvalidOptionError(f"smooth must be a number of rounds >= 0, got {smooth!r}")
         moves = kernel.smooth(len(verts), int(smooth))
     t_aft = time.perf_counter()
     a = kernel.arrays()

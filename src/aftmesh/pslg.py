@@ -22,9 +22,11 @@ from . import _kernel
 from ._order import brio_order
 from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 
-# Coordinates beyond this magnitude could overflow the exact predicates' intermediate
-# products (they square and cube differences of coordinates).
-MAX_COORDINATE = 1e100
+# The exact predicates are exact for coordinates that are 0 or of magnitude between
+# these bounds (beyond, intermediate products could overflow or underflow; see
+# cython_ext/predicates.pxi): other coordinates are refused with a message saying so.
+MAX_COORDINATE = 1e75
+MIN_COORDINATE = 1e-57
 
 
 @dataclass
@@ -50,12 +52,26 @@ def as_points(value, name: str) -> np.ndarray:
     if bad.any():
         i = int(np.flatnonzero(bad)[0])
         raise InvalidInputError(f"{name}[{i}] = {arr[i].tolist()} is not finite")
-    big = np.abs(arr).max(axis=1) > MAX_COORDINATE
+    check_range(arr, name)
+    return np.ascontiguousarray(arr)
+
+
+def check_range(arr: np.ndarray, name: str) -> None:
+    """Refuse coordinates outside the exact predicates' range (see MAX_COORDINATE)."""
+    mag = np.abs(arr)
+    big = (mag > MAX_COORDINATE).any(axis=1)
     if big.any():
         i = int(np.flatnonzero(big)[0])
         raise InvalidInputError(
-            f"{name}[{i}] = {arr[i].tolist()} is too large (|coordinate| > {MAX_COORDINATE:g})")
-    return np.ascontiguousarray(arr)
+            f"{name}[{i}] = {arr[i].tolist()} is too large (|coordinate| > {MAX_COORDINATE:g}, "
+            "beyond the range where the exact predicates are exact): rescale the domain")
+    tiny = ((mag < MIN_COORDINATE) & (mag > 0)).any(axis=1)
+    if tiny.any():
+        i = int(np.flatnonzero(tiny)[0])
+        raise InvalidInputError(
+            f"{name}[{i}] = {arr[i].tolist()} has a coordinate below {MIN_COORDINATE:g} in "
+            "magnitude (but not 0), beneath the range where the exact predicates are exact: "
+            "rescale the domain")
 
 
 def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:

@@ -202,12 +202,17 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
     if have_boundary:
         pts = np.asarray(boundary_points, dtype=np.float64)
         lengths = np.asarray(boundary_lengths, dtype=np.float64)
-        # each boundary vertex asks for its edge length at the grid nodes around it
+        # each boundary vertex asks for its edge length, grown at the gradation rate
+        # out to the four grid nodes around it (not the bare length: a cell is much
+        # larger than a tiny edge, and bilinear interpolation would spread that tiny
+        # size over the whole cell)
+        rate = (gradation if gradation > 1.0 else DEFAULT_GRADATION) - 1.0
         i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
         j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)
         for di in (0, 1):
             for dj in (0, 1):
-                np.minimum.at(h, (j + dj, i + di), lengths)
+                dist = np.hypot(X[j + dj, i + di] - pts[:, 0], Y[j + dj, i + di] - pts[:, 1])
+                np.minimum.at(h, (j + dj, i + di), lengths + rate * dist)
     h = limit_gradation(h, dx, dy, gradation if gradation > 1.0 else DEFAULT_GRADATION
                         if not np.isfinite(h).all() else gradation)
     if not np.isfinite(h).all():
