@@ -352,3 +352,15 @@ def test_predicates_underflow_tiny_triangle_called_collinear():
         assert "collinear" not in str(exc), str(exc)
         return
     assert mesh.n_triangles == 1
+
+
+@pytest.mark.parametrize("regions", [False, 0, 1.5])
+def test_dict_regions_scalar_type_error(regions):
+    """A dict domain whose 'regions' is a scalar (False, 0, 1.5): TypeError "object of
+    type 'bool' has no len()" from `len(regions)` in _from_dict; cdt() with the same
+    regions says 'regions must be rows of (x, y, marker)' (found by the garbage fuzzer,
+    long profile)."""
+    d = {"vertices": [(0, 0), (1, 0), (0, 1)], "segments": [(0, 1), (1, 2), (2, 0)],
+         "regions": regions}
+    with pytest.raises(InvalidInputError, match="regions"):
+        aftmesh.generate(d, 0.5)

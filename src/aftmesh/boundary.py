@@ -16,7 +16,7 @@ _SAMPLES = 32  # points per segment at which the size is read to integrate 1/h
 
 
 def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
-               field: SizeField, max_pieces: int | None = None):
+               field: SizeField, max_pieces: int | None = None, limit: str = ""):
     """Return (vertices, segments, source) with long segments split by the size.
 
     Raises InvalidSizeError, before allocating anything, if the boundary alone would
@@ -46,8 +46,8 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     if max_pieces is not None and not total <= max_pieces:
         from .errors import InvalidSizeError
         raise InvalidSizeError(
-            f"the boundary alone needs about {total:.3g} edges at this size, more than "
-            f"the {max_pieces} triangles allowed")
+            f"{limit} is below what the boundary alone needs: about {total:.3g} edges at "
+            "this size (each a side of a different triangle but for a few)")
     pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
     new_vertices = [vertices]
     new_segments = []

@@ -217,9 +217,15 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
             f"on a domain of area {area_hint:.3g}: more than the {MAX_TRIANGLES} aftmesh "
             "can number")
     if split_boundary:
-        cap = MAX_TRIANGLES if max_triangles is None else max_triangles
+        # a triangle has three sides, so more boundary edges than 3 N_max can never be
+        # meshed within N_max: refuse before allocating them (the exact minimum,
+        # formula (3), is checked once the CDT exists)
+        if max_triangles is None:
+            cap, limit = 3 * MAX_TRIANGLES, f"the limit of {MAX_TRIANGLES} triangles"
+        else:
+            cap, limit = 3 * max_triangles, f"max_triangles={max_triangles}"
         verts, segs, src = discretize(dom.vertices, dom.segments, dom.segment_source, field,
-                                      max_pieces=cap)
+                                      max_pieces=cap, limit=limit)
     else:
         verts, segs, src = dom.vertices, dom.segments, dom.segment_source
     t_boundary = time.perf_counter()
