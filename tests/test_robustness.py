@@ -42,6 +42,10 @@ from shapely.geometry import (GeometryCollection, LineString, MultiPolygon, Poin
                               Polygon, box)
 
 import aftmesh
+
+# child processes import the same aftmesh as this one (installed, or src/ in a
+# development checkout)
+PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(aftmesh.__file__)))
 from aftmesh.aft import Strategy
 from aftmesh import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
                      InvalidOptionError, InvalidSizeError)
@@ -633,7 +637,7 @@ def test_sigint_in_subprocess_exits_cleanly():
         "    print('interrupted', time.perf_counter(), flush=True)\n"
         "m = aftmesh.generate(box(0, 0, 1, 1), 0.1)\n"
         "print('after', m.n_triangles, flush=True)\n")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "src"),
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([PACKAGE_ROOT,
                                                        os.environ.get("PYTHONPATH", "")]))
     proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, env=env)
@@ -718,7 +722,7 @@ def test_same_output_across_processes(tmp_path):
     path.write_text(json.dumps([fd.case_to_json(c) for c in cases]))
     for seed in ("0", "4242"):
         env = dict(os.environ, PYTHONHASHSEED=seed,
-                   PYTHONPATH=os.pathsep.join([str(ROOT / "src"), str(HERE),
+                   PYTHONPATH=os.pathsep.join([PACKAGE_ROOT, str(HERE),
                                                os.environ.get("PYTHONPATH", "")]))
         out = subprocess.run([sys.executable, "-c", DETERMINISM_SCRIPT, str(HERE), str(path)],
                              env=env, capture_output=True, text=True, timeout=300)

@@ -289,14 +289,17 @@ def _from_dict(d: dict) -> Domain:
     holes = as_points(d.get("holes", np.zeros((0, 2))), "holes")
     regions = d.get("regions")
     reg = None
-    if regions is not None and len(regions):
+    if regions is not None:
         try:
             reg = np.asarray(regions, dtype=np.float64)
         except (TypeError, ValueError) as exc:
             raise InvalidInputError(f"regions must be rows of (x, y, marker[, max_area]): {exc}") from None
-        if reg.ndim != 2 or reg.shape[1] < 3:
+        if reg.size == 0:
+            reg = None
+        elif reg.ndim != 2 or reg.shape[1] < 3:
             raise InvalidInputError(f"regions must have shape (r, 3) or (r, 4), got {reg.shape}")
-        reg = reg[:, :3]
+        else:
+            reg = reg[:, :3]
     markers = d.get("segment_markers")
     src = np.arange(len(seg), dtype=np.int32)
     if markers is not None:
