@@ -95,25 +95,8 @@ cdef tuple _centroid(Tri* T, int t):
     return ((a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0)
 
 
-cdef bint _vertex_on_segment(Tri* T, int v) noexcept nogil:
-    cdef int e0 = T.vhe[v], e = e0
-    while True:
-        if T.eflag[e] & E_SEGMENT:
-            return True
-        e = T.twin[prv(e)]
-        if e == e0:
-            return False
-
-
-cdef int _seed_triangle(Tri* T, int loc, int where) noexcept nogil:
-    """The triangle a flood fill starts from for a seed point located at (loc, where)."""
-    if loc == LOC_IN_TRIANGLE:
-        return where
-    if loc == LOC_ON_EDGE:
-        return where // 3
-    if loc == LOC_ON_VERTEX:
-        return T.vhe[where] // 3
-    return NONE
+# Coordinates (besides 0) for which orient2d and incircle are exact (predicates.pxi).
+EXACT_COORDINATE_RANGE = (EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
 
 
 cdef class Triangulation:
@@ -192,9 +175,10 @@ cdef class Triangulation:
         return merged_arr
 
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT):
-        """Insert constrained edges (pairs of vertex indices).  On a crossing, raises
-        CrossingError with `index` set to the row that failed."""
-        cdef int i, res = 0, failed = -1
+        """Insert constrained edges (pairs of vertex indices).  Returns how many of
+        them ran exactly through other vertices and were split there.  On a crossing,
+        raises CrossingError with `index` set to the row that failed."""
+        cdef int i, res = 0, failed = -1, through = 0
         cdef int m = segments.shape[0]
         cdef Tri* T = &self.T
         with nogil:
@@ -203,11 +187,13 @@ cdef class Triangulation:
                 if res < 0:
                     failed = i
                     break
+                through += res
         try:
             _raise_for(T, res)
         except CrossingError as err:
             err.index = failed
             raise
+        return through
 
     def carve(self, const double[:, ::1] holes, bint from_hull=True):
         """Mark as exterior the triangles reachable without crossing a segment from the

@@ -275,7 +275,8 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
 
 cdef int insert_segment(Tri* T, int a, int b, uint8_t flag) noexcept nogil:
     """Make a-b an edge of the triangulation with `flag` set on it (on each piece, if
-    vertices lie exactly on a-b: the segment is then split there)."""
+    vertices lie exactly on a-b: the segment is then split there).  Returns 0, or 1 if
+    it was split, or a negative error code."""
     cdef int reached = NONE, res, guard = 0
     while a != b:
         res = _insert_piece(T, a, b, flag, &reached)
@@ -285,7 +286,7 @@ cdef int insert_segment(Tri* T, int a, int b, uint8_t flag) noexcept nogil:
         guard += 1
         if guard > T.nv + 1:
             return ERR_INTERNAL
-    return 0
+    return 1 if guard > 1 else 0
 
 
 # ---------------------------------------------------------------- flood fills
@@ -314,3 +315,27 @@ cdef int flood(Tri* T, int nseed, uint8_t from_state, uint8_t to_state, int32_t 
                 T.stack[sp] = u
                 sp += 1
     return 0
+
+
+# Seeds of the flood fills: hole and region points located in the triangulation.
+
+cdef bint _vertex_on_segment(Tri* T, int v) noexcept nogil:
+    """Whether a constrained edge ends at v (a seed located on v lies on a segment)."""
+    cdef int e0 = T.vhe[v], e = e0
+    while True:
+        if T.eflag[e] & E_SEGMENT:
+            return True
+        e = T.twin[prv(e)]
+        if e == e0:
+            return False
+
+
+cdef int _seed_triangle(Tri* T, int loc, int where) noexcept nogil:
+    """The triangle a flood fill starts from for a seed point located at (loc, where)."""
+    if loc == LOC_IN_TRIANGLE:
+        return where
+    if loc == LOC_ON_EDGE:
+        return where // 3
+    if loc == LOC_ON_VERTEX:
+        return T.vhe[where] // 3
+    return NONE

@@ -184,6 +184,11 @@ from libc.math cimport fabs, fma
 #       2 products * (2*2 component pairs) * 2 doubles per two-product = 16;
 #   a lifted term dx^2 + dy^2: the same count, 16;
 #   the incircle determinant: 3 terms * (16*16 pairs) * 2 doubles = 1536.
+# The range of EXACT RANGE above, as numbers: the Python layer refuses
+# coordinates outside it (aftmesh.pslg.check_range reads it from the kernel).
+cdef double EXACT_MIN_COORDINATE = 1e-57
+cdef double EXACT_MAX_COORDINATE = 1e75
+
 cdef enum:
     _exp_max_diff = 2
     _exp_max_cross = 16

@@ -353,26 +353,6 @@ def assert_cdt(mesh) -> None:
                      f"{len(bad)} edges fail the exact empty-circle test, e.g. {bad[:3]}")
 
 
-def components_of(mesh) -> np.ndarray:
-    """Connected component (through shared edges) of each triangle."""
-    N = np.asarray(mesh.neighbors)
-    comp = np.full(len(N), -1)
-    c = 0
-    for s in range(len(N)):
-        if comp[s] >= 0:
-            continue
-        comp[s] = c
-        stack = [s]
-        while stack:
-            u = stack.pop()
-            for w in N[u]:
-                if w >= 0 and comp[w] < 0:
-                    comp[w] = c
-                    stack.append(w)
-        c += 1
-    return comp
-
-
 def coordinate_keys(points) -> set:
     return {(float(x), float(y)) for x, y in np.asarray(points)}
 

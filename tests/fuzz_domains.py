@@ -360,7 +360,13 @@ def corner_points(case: FuzzCase) -> np.ndarray:
                 pts.append(b)
     for p in case.points:
         pts.append(np.asarray(p.coords, dtype=float)[0, :2])
-    return np.unique(np.array(pts, dtype=float).reshape(-1, 2), axis=0)
+    P = np.unique(np.array(pts, dtype=float).reshape(-1, 2), axis=0)
+    if case.lines and len(P):
+        # a line ending on the boundary at a rounded point may end just outside it:
+        # such an end cannot be a mesh vertex (the line is cut at the boundary)
+        union = shapely.union_all(case.polygons)
+        P = P[shapely.covers(union, shapely.points(P))]
+    return P
 
 
 def input_edges(case: FuzzCase, merge: bool = False) -> np.ndarray:
@@ -549,10 +555,25 @@ def _check_unsplit(mesh, case: FuzzCase, have: set) -> None:
 
 def acceptable_refusal(case: FuzzCase, exc: BaseException) -> bool:
     """Refusals that are right for a valid domain: max_triangles below what the
-    boundary alone needs (formula (3))."""
-    return (isinstance(exc, aftmesh.InvalidSizeError)
+    boundary alone needs (formula (3)); a size finer than the coordinates can
+    resolve; coordinates far outside the range of the exact predicates."""
+    if (isinstance(exc, aftmesh.InvalidSizeError)
             and case.options.get("max_triangles") is not None
-            and "triangles" in str(exc))
+            and "triangles" in str(exc)):
+        return True
+    # a size finer than the coordinates resolve (sizing.MIN_SIZE_ULPS of their
+    # spacing), refused as such: only when the case's smallest size really is
+    if isinstance(exc, aftmesh.InvalidSizeError) and "coordinates can resolve" in str(exc):
+        from aftmesh.sizing import MIN_SIZE_ULPS
+        spec = case.size
+        smallest = float(spec["lo"]) if isinstance(spec, dict) else spec
+        mag = max(float(np.abs(np.asarray(p.bounds)).max()) for p in case.polygons)
+        return smallest is not None and smallest < MIN_SIZE_ULPS * float(np.spacing(mag))
+    # coordinates beyond the exact predicates' range, refused as such
+    if isinstance(exc, aftmesh.InvalidInputError) and "coordinate" in str(exc).lower():
+        c = np.abs(np.concatenate([np.asarray(p.bounds).reshape(2, 2) for p in case.polygons]))
+        return bool((c > 1e50).any() or ((c > 0) & (c < 1e-40)).any())
+    return False
 
 
 def run_case(case: FuzzCase, check=check_mesh, timeout: float | None = None):
@@ -886,8 +907,58 @@ def with_constraints(draw):
         p = Point(draw(_finite_floats(x0, x1)), draw(_finite_floats(y0, y1)))
         if inner.contains(p):
             points.append(p)
+    # lines ending on the boundary (at a rounded point of an edge, or at a vertex)
+    ring = _ring_coords(poly.exterior)
+    for _ in range(draw(st.integers(0, 2))):
+        i = draw(st.integers(0, len(ring) - 1))
+        a, b = ring[i], ring[(i + 1) % len(ring)]
+        end = a if draw(st.booleans()) else a + draw(_finite_floats(0.1, 0.9)) * (b - a)
+        q = (draw(_finite_floats(x0, x1)), draw(_finite_floats(y0, y1)))
+        line = LineString([q, tuple(end)])
+        if inner.contains(Point(q)) and line.length > 0 and \
+                line.difference(poly).length <= 1e-9 * line.length:
+            lines.append(line)
+    # fixed points on the lines
+    for line in list(lines):
+        if draw(st.integers(0, 2)) == 0:
+            points.append(line.interpolate(0.5, normalized=True))
     assume(lines or points)
     return "constraints", GeometryCollection([poly, *lines, *points])
+
+
+@st.composite
+def nested_regions(draw):
+    """Region lists: a rectangle with holes, regions filling some of the holes
+    (inclusions), and a neighbour sharing part of an edge."""
+    W = draw(_finite_floats(1.0, 3.0))
+    H = draw(_finite_floats(1.0, 3.0))
+    k = draw(st.integers(1, 3))
+    holes = []
+    for j in range(k):
+        cx = W * (j + 0.5) / k
+        r = min(W / k, H) * draw(_finite_floats(0.1, 0.4))
+        holes.append(_ngon(cx, H / 2, r, draw(st.integers(3, 9)), draw(_finite_floats(0, 6.3))))
+    regions = [Polygon([(0, 0), (W, 0), (W, H), (0, H)], holes)]
+    for h in holes:
+        if draw(st.booleans()):
+            regions.append(Polygon(h))
+    y0 = draw(_finite_floats(0.0, H / 2))
+    regions.append(box(W, y0, W + draw(_finite_floats(0.3, 2.0)), y0 + draw(_finite_floats(0.2, H))))
+    assume(all(_valid(r) for r in regions))
+    return "nested-regions", regions
+
+
+@st.composite
+def extreme_scales(draw):
+    """A valid domain scaled by 10**k, k from -70 to 80: far beyond what the exact
+    predicates can handle at both ends, where the only right answers are a correct
+    mesh or an InvalidInputError about the coordinates."""
+    _, g = draw(st.one_of(star_polygons(max_vertices=12), many_holes(), grid_unions()))
+    k = draw(st.integers(-70, 80))
+    scale = 10.0 ** k
+    g = shapely.transform(g, lambda c: c * scale)
+    assume(_valid(g))
+    return "extreme", g
 
 
 GENERATORS = {
@@ -901,6 +972,8 @@ GENERATORS = {
     "collinear": near_collinear(),
     "cocircular": cocircular(),
     "constraints": with_constraints(),
+    "regions": nested_regions(),
+    "extreme": extreme_scales(),
 }
 
 

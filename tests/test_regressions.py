@@ -15,11 +15,11 @@ import time
 
 import numpy as np
 import pytest
-from shapely.geometry import GeometryCollection, LineString, Polygon, box
+from shapely.geometry import GeometryCollection, LineString, Point, Polygon, box
 
 import aftmesh
-from aftmesh import (CrossingSegmentsError, InvalidInputError, InvalidOptionError,
-                     InvalidSizeError)
+from aftmesh import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
+                     InvalidOptionError, InvalidSizeError)
 
 import fuzz_domains as fd
 
@@ -364,3 +364,214 @@ def test_dict_regions_scalar_type_error(regions):
          "regions": regions}
     with pytest.raises(InvalidInputError, match="regions"):
         aftmesh.generate(d, 0.5)
+
+
+def test_constraint_ending_just_inside_edge_crossed_by_split_points(checked):
+    """A crack from the centre of a triangle to the midpoint of an edge, computed as
+    a + 0.5 (b - a): the rounded end is strictly inside, 6e-18 from the edge.  The
+    PSLG is fine (no crossing), but the points that split the edge for the size are
+    rounded too, and a piece of the split edge then passes on the other side of the
+    end: CrossingSegmentsError 'the polygon, exterior ring ... and constraint line 0'
+    with size None or 0.2 (size 0.5, no split point nearby, works).  Found by the
+    fuzzer (lines ending on the boundary)."""
+    w = np.ones(3)
+    theta = np.cumsum(w) / w.sum() * 2 * np.pi
+    r = np.array([1.0, 1.0, 0.5])
+    ring = np.c_[r * np.cos(theta), r * np.sin(theta)]
+    end = ring[1] + 0.5 * (ring[2] - ring[1])
+    assert end.tolist() == [-2.220446049250313e-16, -0.43301270189221924]
+    poly = Polygon(ring)
+    line = LineString([(0.0, 0.0), tuple(end)])
+    for size in (None, 0.2):
+        mesh = aftmesh.generate(GeometryCollection([poly, line]), size)
+        checked(mesh, domain_area=fd.exact_area([poly]))
+        assert tuple(end) in set(map(tuple, np.asarray(mesh.points).tolist()))
+
+
+@pytest.mark.parametrize("t", [0.1, 0.3, 0.6])
+def test_constraint_ending_on_edge_far_from_origin(t, checked):
+    """A regular 12-gon of radius 1 around (1e7, -1e7) and a crack from near the
+    centre to a point of its last edge (computed at the origin, then moved): t=0.1
+    'constraint line 0 is not inside the domain' (the tolerance is 1e-9 of the line's
+    length, the rounding is an ulp of 1e7, 1.9e-9), t=0.3 / 0.6 CrossingSegmentsError
+    between the line and itself or the ring.  The same at the origin meshes.  Found
+    by the fuzzer (constraints+offset)."""
+    th = 2 * np.pi * np.arange(1, 13) / 12
+    ring = np.c_[np.cos(th), np.sin(th)]
+    off = np.array([1e7, -1e7])
+    a, b = ring[11], ring[0]
+    end = a + t * (b - a)
+    poly = Polygon(ring + off)
+    gc = GeometryCollection([poly, LineString([tuple(np.array([0.1, 0.05]) + off),
+                                               tuple(end + off)])])
+    mesh = aftmesh.generate(gc, 0.2)
+    checked(mesh, domain_area=fd.exact_area([poly]),
+            area_rtol=fd.area_tolerance(fd.FuzzCase("12-gon", poly, 0.2, {}, [poly]),
+                                        fd.exact_area([poly])))
+
+
+@pytest.mark.parametrize("size", [5e-9, 1e-9])
+def test_size_below_coordinate_resolution_zero_length_segments(size, checked):
+    """A square of side 1e-7 at (4.5e7, 4.5e7), where an ulp is 7.45e-9, with a size
+    below the ulp: the boundary is split into pieces whose rounded ends coincide, and
+    build_cdt reports 'segments[1] = [4, 5] has zero length', indices of pieces the
+    user never gave.  Either mesh it (no split below the coordinates' resolution) or
+    say that the size is below what the coordinates can resolve.  Found by the fuzzer
+    (extreme+offset)."""
+    off = 4.5e7
+    sq = box(off, off, off + 1e-7, off + 1e-7)
+    try:
+        mesh = aftmesh.generate(sq, size)
+    except InvalidSizeError as exc:
+        assert "segments[" not in str(exc), str(exc)
+        return
+    checked(mesh, domain_area=fd.exact_area([sq]),
+            area_rtol=fd.area_tolerance(fd.FuzzCase("sq", sq, size, {}, [sq]),
+                                        fd.exact_area([sq])))
+
+
+def test_grazing_constraint_pieces_cross_after_discretization(checked):
+    """A constraint line 3e-14 rad off a boundary edge, ending on it: no vertex is
+    within rounding of another segment, so the noded input is clean, but 0.02 from the
+    shared end the two are only an ulp apart, and the rounded points that split them
+    for the size make a piece of one cross a piece of the other (CrossingSegmentsError
+    naming the exterior ring and constraint line 0).  generate now discretizes again
+    without the split points that close to another segment.  Found by a search for
+    grazing lines after the snapping fix."""
+    a, b = (0.0, 0.0), (1.0, 0.40525141301762135)
+    q, end = (0.09628104213614674, 0.039018028372485636), (0.9628104213614773, 0.3901802837248301)
+    poly = Polygon([a, b, (0.5, 1.0)])
+    mesh = aftmesh.generate(GeometryCollection([poly, LineString([q, end])]), 0.02)
+    checked(mesh, domain_area=poly.area)
+    # the repair ran (the test would otherwise not test it)
+    assert "left out split points within rounding of other segments" in mesh.info["cleanup"]
+    assert {q, end} <= set(map(tuple, np.asarray(mesh.points).tolist()))
+
+
+def test_constraint_ending_an_ulp_outside_the_boundary(checked):
+    """A line from inside to a point computed on an edge that rounds 1.4e-17 outside
+    the triangle.  Accepting lines outside by less than 1e-9 of their length (the rule
+    before) let far bigger misses through; a buffer of a few ulps (GEOS rounds a buffer
+    that thin back onto the polygon) refused this one as 'constraint line 0 is not
+    inside the domain'.  Now the outside part's ends and middle must lie within the
+    snapping tolerance of the domain.  Found by the fuzzer (constraints)."""
+    poly = Polygon([(-0.6541631149290893, 0.618118612457408),
+                    (0.46312640783270953, -0.796575090255773),
+                    (0.9924533439941903, -2.4308096220511445e-16)])
+    end = (-0.4895014690367614, 0.5563067512116672)
+    assert not poly.covers(Point(end))
+    line = LineString([(0.6264150616181526, 0.0), end])
+    mesh = checked(aftmesh.generate(GeometryCollection([poly, line]), 0.35),
+                   domain_area=poly.area)
+    assert end in set(map(tuple, np.asarray(mesh.points).tolist()))
+    # a line that really leaves the domain is still refused
+    with pytest.raises(InvalidDomainError, match="constraint line 0"):
+        aftmesh.generate(GeometryCollection([poly, LineString([(0.6, 0.0), (-0.5, 0.6)])]), 0.35)
+
+
+def test_needle_an_ulp_wide_is_not_folded_by_snapping(checked):
+    """A spike whose two sides are 1.5 ulps apart at its base: the base vertex is
+    within the snapping tolerance of the spike's other side, and splitting that side
+    there folded the spike onto it (the doubled piece dropped), losing the corner at
+    its tip ('input corner (1.229e-07, 1e-06) is not a mesh vertex').  A vertex joined
+    by a segment to an end of the segment is not snapped onto it.  Found by the fuzzer
+    (walk+small, split_boundary=False)."""
+    ring = [(4.314853096290475e-7, 8.461878383307198e-7), (7.891278723393342e-7, 8.99208396012279e-7),
+            (8.808360498265026e-7, 5.923608809873998e-7), (0.0, 3.778579095052713e-7),
+            (1.544068913417336e-7, 9.999999999999997e-7), (1.229362482212402e-7, 1e-6),
+            (9.508644384332265e-7, 9.999999999999997e-7)]
+    poly = Polygon(ring)
+    assert poly.is_valid
+    for split in (False, True):
+        mesh = checked(aftmesh.generate(poly, 4.5452462393882883e-07, split_boundary=split),
+                       domain_area=poly.area, area_rtol=1e-9)
+        assert (1.229362482212402e-7, 1e-6) in set(map(tuple, np.asarray(mesh.points).tolist()))
+
+
+def test_gap_of_a_few_ulps_far_from_origin_is_not_closed(checked):
+    """A random-walk polygon around 7.1e7, where an ulp is 1.5e-8: one vertex is 3
+    ulps from an edge it is not joined to.  Snapping within 8 ulps split the edge there
+    and closed the gap, bending the boundary by 2.98e-8 ('mesh segment point ... is
+    2.98e-08 away from every input edge'); the tolerance is now 2 ulps, the rounding of
+    a computed point.  Found by the fuzzer (walk+offset)."""
+    ring = [[71066330.76221266, -71066330.08782011], [71066331.4934162, -71066330.22925001],
+            [71066331.26221254, -71066329.77443752], [71066331.68696073, -71066330.26221254],
+            [71066330.92969792, -71066330.26221254], [71066330.87220481, -71066330.12522256],
+            [71066330.7622126, -71066330.61966804], [71066331.6997911, -71066330.41034773],
+            [71066331.43241991, -71066330.52795883], [71066331.46262462, -71066330.76221243],
+            [71066330.76221254, -71066330.76221254]]
+    poly = Polygon(ring)
+    case = fd.FuzzCase("walk+offset", np.array(ring), None,
+                       {"smooth": 0, "close_factor": 1.0, "gradation": 2.0}, [poly])
+    fd.verify(case.call(), case, check=checked)
+
+
+def test_crossing_points_closer_than_a_dot_products_ulp_ordered_exactly(checked):
+    """Constraint lines through the origin: a nearly vertical line crosses two nearly
+    collinear ones at points 3e-24 apart.  Ordering the cut points along the line by a
+    dot product (whose ulp there is 5e-20) put them the wrong way round, the pieces
+    crossed again after every round of noding, and generate raised
+    CrossingSegmentsError naming constraint lines 1 and 0.  The points are now ordered
+    by their coordinates.  Found by the fuzzer (constraints)."""
+    poly = Polygon([(-0.07021862439709335, 0.2916664958266203),
+                    (-0.27763851442294835, 0.1136523440542178),
+                    (-0.2545812678208489, -0.1587084688185517),
+                    (-0.0010009756642637793, -0.29999833007488486),
+                    (0.3, -7.347880794884119e-17)])
+    lines = [LineString([(-0.18362673833910703, 0.0), (0.0, 0.0), (-6.103515625e-05, -0.22903685508655236)]),
+             LineString([(-1e-12, 0.01), (0.0, -0.01595904312880836)]),
+             LineString([(0.0, 0.0), (0.14995309559710446, 0.0), (0.0, 0.04)]),
+             LineString([(-0.20199876099902425, 1e-12), (0.0, 0.0)])]
+    points = [Point(-0.02791090438228072, 0.0), Point(-0.14331543830913562, 0.0),
+              Point(-1e-12, -0.14331543830913562), Point(-6.050585107623707e-06, -0.022705061633780332),
+              Point(-0.10099938049951213, 5e-13)]
+    gc = GeometryCollection([poly, *lines, *points])
+    case = fd.FuzzCase("constraints", gc, 0.033075272202751325, {}, [poly], lines, points)
+    fd.verify(case.call(), case, check=checked)
+
+
+def test_needle_an_ulp_wide_keeps_its_tip_when_split(checked):
+    """A random-walk polygon at the 1e-6 scale with a needle whose sides are 1.5 ulps
+    apart at its base.  Split for the size, every point of the slanted side rounds onto
+    the other side's line, so the CDT split that side at them, the needle folded, and
+    its tip vanished from the mesh ('input corner (2.852e-07, 1e-06) is not a mesh
+    vertex'; the area, 1e-29 less, passed).  The kernel now reports segments split at
+    vertices, and generate discretizes again without points that near another
+    segment.  Found by the fuzzer (walk+small)."""
+    ring = [[3.365591503278354e-08, 9.999999999999997e-07], [2.8521983272121794e-07, 9.999999999999997e-07],
+            [6.103515625e-11, 1e-06], [3.1674308885637164e-07, 5.777133618857241e-07],
+            [2.8307677230474166e-07, 4.6516809204126516e-07], [1.8810652526464105e-07, 4.1233067142958254e-07],
+            [2.0506592346896916e-07, 2.438754591477639e-07], [5.944269154557481e-08, 6.786467533946002e-07],
+            [0.0, 9e-07], [1.2244750328600287e-08, 8.314294512989135e-07], [1e-08, 5.747665969808581e-10],
+            [2.2825022669867483e-07, 1e-15], [2.8208801168840887e-07, 0.0],
+            [5.947544962168446e-07, 9.562273431928417e-08], [3.957667256828735e-07, 3.3757317098125885e-07],
+            [8.739637673251436e-07, 0.0], [9.866719170190173e-07, 5.960464477539062e-14],
+            [7.172939875172807e-07, 3.591666631337065e-07], [8e-07, 7.050797155870397e-07],
+            [8.247591710380309e-07, 7.715719962420504e-07], [7.589706357580982e-07, 8.366352297394527e-07],
+            [5e-07, 8.160423708849393e-07], [4.829580031870927e-07, 5.93929950787107e-07],
+            [4.5360759708002493e-07, 8.149196246897969e-07], [3.260876812422793e-07, 6.627654590875148e-07],
+            [1.6261346477560148e-07, 7.894636442165441e-07]]
+    poly = Polygon(ring)
+    assert poly.is_valid
+    case = fd.FuzzCase("walk+small", poly, 7.024103985267414e-08, {}, [poly])
+    mesh = case.call()
+    fd.verify(mesh, case, check=checked)
+    assert "left out split points within rounding of other segments" in mesh.info["cleanup"]
+
+
+def test_dict_segment_through_a_vertex_split_before_discretization(checked):
+    """A dict whose segment 0 runs exactly through vertex 4 (the end of segment 4):
+    split there before the size splits it, so the rounded split points cannot miss the
+    vertex; the pieces keep segment 0's marker."""
+    d = {"vertices": [[0, 0], [3, 1], [0, 2], [-1, 1], [1.5, 0.5], [1.0, 1.0]],
+         "segments": [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5]],
+         "segment_markers": [7, 8, 9, 10, 11]}
+    mesh = checked(aftmesh.generate(d, 0.13), domain_area=4.0)
+    assert any("split 1 segments at vertices" in c for c in mesh.info["cleanup"])
+    P = np.asarray(mesh.points)
+    S = np.asarray(mesh.segments)
+    markers = np.asarray(mesh.segment_markers)
+    assert [1.5, 0.5] in P.tolist()
+    # pieces of segment 0: both ends on the line y = x / 3 (exact for these points)
+    on0 = (3 * P[S[:, 0], 1] == P[S[:, 0], 0]) & (3 * P[S[:, 1], 1] == P[S[:, 1], 0])
+    assert on0.any() and (markers[on0] == 7).all()

@@ -36,7 +36,13 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _paths():
-    for p in (ROOT / "src", ROOT / "tests"):
+    # the fuzz domains from tests/; aftmesh from src/ if its kernel was built there
+    # (setup.py build_ext --inplace), otherwise the installed one
+    paths = [ROOT / "tests"]
+    if any((ROOT / "src" / "aftmesh").glob("_kernel*.so")) or \
+            any((ROOT / "src" / "aftmesh").glob("_kernel*.pyd")):
+        paths.append(ROOT / "src")
+    for p in paths:
         if str(p) not in sys.path:
             sys.path.insert(0, str(p))
 

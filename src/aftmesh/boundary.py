@@ -16,11 +16,18 @@ _SAMPLES = 32  # points per segment at which the size is read to integrate 1/h
 
 
 def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
-               field: SizeField, max_pieces: int | None = None, limit: str = ""):
+               field: SizeField, max_pieces: int | None = None, limit: str = "",
+               clear: float = 0.0):
     """Return (vertices, segments, source) with long segments split by the size.
 
     Raises InvalidSizeError, before allocating anything, if the boundary alone would
-    need more than `max_pieces` edges (each is a side of a triangle of the mesh)."""
+    need more than `max_pieces` edges (each is a side of a triangle of the mesh).
+
+    With `clear` > 0, a split point within that distance of another segment is left
+    out.  A split point is rounded, so where two segments are within an ulp or two of
+    each other (the sides of a needle, a line grazing an edge) it may land on the
+    other segment or beyond it, which would change the PSLG's topology; leaving it out
+    only makes a piece longer than the size asks for."""
     if len(segments) == 0:
         return vertices, segments, source
     a = vertices[segments[:, 0]]
@@ -49,6 +56,15 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
             f"{limit} is below what the boundary alone needs: about {total:.3g} edges at "
             "this size (each a side of a different triangle but for a few)")
     pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
+    split = np.flatnonzero(pieces > 1)
+    points = []
+    for k in split:
+        n = int(pieces[k])
+        targets = cum[k, -1] * np.arange(1, n) / n
+        t = np.interp(targets, cum[k], s)
+        points.append(a[k] + np.outer(t, b[k] - a[k]))
+    if clear > 0 and points:
+        points = _clear_of_others(points, split, a, b, clear)
     new_vertices = [vertices]
     new_segments = []
     new_source = []
@@ -56,16 +72,38 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     simple = pieces == 1
     new_segments.append(segments[simple])
     new_source.append(source[simple])
-    for k in np.flatnonzero(~simple):
-        n = int(pieces[k])
-        targets = cum[k, -1] * np.arange(1, n) / n
-        t = np.interp(targets, cum[k], s)
-        pts = a[k] + np.outer(t, b[k] - a[k])
-        idx = np.arange(next_index, next_index + n - 1)
-        next_index += n - 1
+    for k, pts in zip(split, points):
+        # rounded points never coincide at the sizes make_size_field accepts, but a
+        # piece of zero length would be fatal: drop any that do
+        prev = np.vstack([a[k], pts[:-1]])
+        distinct = (pts != prev).any(axis=1) & (pts != b[k]).any(axis=1)
+        if not distinct.all():
+            pts = pts[distinct]
+        m = len(pts)
+        idx = np.arange(next_index, next_index + m)
+        next_index += m
         chain = np.concatenate([[segments[k, 0]], idx, [segments[k, 1]]])
         new_vertices.append(pts)
         new_segments.append(np.c_[chain[:-1], chain[1:]])
-        new_source.append(np.full(n, source[k]))
+        new_source.append(np.full(m + 1, source[k]))
     return (np.concatenate(new_vertices), np.concatenate(new_segments).astype(np.int32),
             np.concatenate(new_source).astype(np.int32))
+
+
+def _clear_of_others(points, split, a, b, clear):
+    """Drop from points[i] (the split points of segment split[i]) those within
+    `clear` of any other segment."""
+    import shapely
+    lines = shapely.linestrings(np.stack([a, b], axis=1))
+    allp = np.concatenate(points)
+    parent = np.repeat(split, [len(p) for p in points])
+    pi, si = shapely.STRtree(lines).query(shapely.points(allp), predicate="dwithin",
+                                          distance=clear)
+    keep = np.ones(len(allp), dtype=bool)
+    keep[pi[si != parent[pi]]] = False
+    out = []
+    start = 0
+    for p in points:
+        out.append(p[keep[start:start + len(p)]])
+        start += len(p)
+    return out

@@ -20,7 +20,7 @@ import numpy as np
 from . import _kernel
 from .mesh import Mesh
 
-__all__ = ["MeshCheckError", "check_mesh", "count_formula"]
+__all__ = ["MeshCheckError", "check_mesh", "count_formula", "triangle_components"]
 
 
 class MeshCheckError(AssertionError):
@@ -217,17 +217,13 @@ def boundary_curves(points: np.ndarray, triangles: np.ndarray) -> int:
     return curves
 
 
-def count_formula(mesh: Mesh):
-    """Per connected component of the mesh: (T, E_b, V_i, m), with m + 1 the number of
-    its boundary curves (see :func:`boundary_curves`).  The appendix's formula (6)
-    states T = E_b + 2 V_i + 2 (m - 1)."""
-    P = np.asarray(mesh.points)
-    T = np.asarray(mesh.triangles)
+def triangle_components(mesh: Mesh) -> np.ndarray:
+    """The connected component (through shared edges) of each triangle, numbered from 0
+    in the order of their first triangles."""
     N = np.asarray(mesh.neighbors)
-    t = len(T)
-    comp = np.full(t, -1)
+    comp = np.full(len(N), -1)
     c = 0
-    for start in range(t):
+    for start in range(len(N)):
         if comp[start] >= 0:
             continue
         stack = [start]
@@ -239,6 +235,17 @@ def count_formula(mesh: Mesh):
                     comp[w] = c
                     stack.append(w)
         c += 1
+    return comp
+
+
+def count_formula(mesh: Mesh):
+    """Per connected component of the mesh: (T, E_b, V_i, m), with m + 1 the number of
+    its boundary curves (see :func:`boundary_curves`).  The appendix's formula (6)
+    states T = E_b + 2 V_i + 2 (m - 1)."""
+    P = np.asarray(mesh.points)
+    T = np.asarray(mesh.triangles)
+    comp = triangle_components(mesh)
+    c = int(comp.max()) + 1 if len(comp) else 0
     out = []
     for k in range(c):
         tk = T[comp == k]

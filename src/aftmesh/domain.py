@@ -13,7 +13,9 @@ Accepted forms (see :func:`aftmesh.generate`):
   path of a Triangle ``.poly`` file.
 
 Clean-up done and reported in ``Mesh.info['cleanup']``: repeated vertices, a repeated
-closing vertex, collinear runs, rings in either orientation.
+closing vertex, collinear runs, rings in either orientation, segments split at the
+vertices lying on them (or within rounding of them, see :func:`snap_tolerance`) and at
+their crossings.
 """
 from __future__ import annotations
 
@@ -183,53 +185,103 @@ def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: lis
                   polygons=polygons, area=union_area, cleanup=note)
 
 
+def snap_tolerance(pts: np.ndarray) -> float:
+    """How near a vertex must be to a segment to count as lying on it: two units in
+    the last place (ulps) of the largest coordinate.  Points computed from the input (a
+    line's end at a + t (b - a), a crossing point, the points that split an edge for
+    the size) are off by up to about one such unit, so a vertex that near an edge may
+    land on either side of it or of the pieces it is split into; splitting the edge at
+    the vertex bends it by no more than that and removes the ambiguity.  (Larger, it
+    would close gaps a valid polygon has on purpose; what it leaves, generate repairs
+    after the discretization.)"""
+    if len(pts) == 0:
+        return 0.0
+    return 2.0 * float(np.spacing(np.abs(pts).max()))
+
+
 def _merge_and_node(verts, segs, src, note):
     """Make the input edges a proper PSLG: merge coincident vertices, split every
-    segment at the input vertices lying exactly inside it (a hole touching the outer
-    ring, a T-junction between regions, a constraint line ending on a boundary), drop
-    segments given twice (a boundary shared by two regions), and split segments that
-    cross each other at their crossing points."""
+    segment at the input vertices lying on it or within rounding of it (a hole touching
+    the outer ring, a T-junction between regions, a constraint line ending on a
+    boundary), drop segments given twice (a boundary shared by two regions), and split
+    segments that cross each other at their crossing points."""
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
-    segs, src = _split_at_vertices(uniq, segs, src, note)
+    tol = snap_tolerance(uniq)
+    segs, src = _split_at_vertices(uniq, segs, src, note, tol)
     segs, src = _drop_repeats(segs, src)
-    if len(segs) == 0:
-        return uniq, segs, src
-    # crossings (shapely finds them; touching at vertices was handled above)
-    lines = shapely.linestrings(np.stack([uniq[segs[:, 0]], uniq[segs[:, 1]]], axis=1))
+    return node_crossings(uniq, segs, src, note, tol)
+
+
+def _crossing_pairs(verts, segs):
+    lines = shapely.linestrings(np.stack([verts[segs[:, 0]], verts[segs[:, 1]]], axis=1))
     pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
-    pairs = pairs[:, pairs[0] < pairs[1]]
-    if pairs.shape[1] == 0:
-        return uniq, segs, src
-    # cut both segments of each crossing pair at the computed crossing point; it is
-    # rounded, so it is not exactly on either segment, but within an ulp of both, and
-    # the two pieces of each segment bend by that much at most
-    base = len(uniq)
-    extra = []
-    cuts: dict[int, list[int]] = {}
-    for i, j in pairs.T:
-        for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
-            if isinstance(p, Point):
-                extra.append(np.asarray(p.coords)[0, :2])
-                cuts.setdefault(int(i), []).append(base + len(extra) - 1)
-                cuts.setdefault(int(j), []).append(base + len(extra) - 1)
-    note.append(f"split segments at {pairs.shape[1]} crossings")
-    verts = np.concatenate([uniq, np.array(extra).reshape(-1, 2)])
+    return lines, pairs[:, pairs[0] < pairs[1]]
+
+
+def node_crossings(verts, segs, src, note, tol=None, rounds: int = 8):
+    """Split the segments that cross each other at their crossing points, until none
+    cross.  A crossing point is rounded, so it is not exactly on either segment, but
+    within an ulp of both: the two pieces of each segment bend by that much at most,
+    and a bent piece may, rarely, cross another segment that passes just as near; so
+    this repeats (a few rounds at most in practice).  Returns (vertices, segments,
+    source); segments still crossing after `rounds` rounds are left for the CDT to
+    report."""
+    if tol is None:
+        tol = snap_tolerance(verts)
+    n_cut = 0
+    for _ in range(rounds):
+        if len(segs) < 2:
+            break
+        lines, pairs = _crossing_pairs(verts, segs)
+        if pairs.shape[1] == 0:
+            break
+        base = len(verts)
+        extra = []
+        cuts: dict[int, list[int]] = {}
+        for i, j in pairs.T:
+            for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
+                if isinstance(p, Point):
+                    extra.append(np.asarray(p.coords)[0, :2])
+                    cuts.setdefault(int(i), []).append(base + len(extra) - 1)
+                    cuts.setdefault(int(j), []).append(base + len(extra) - 1)
+        if not extra:
+            break
+        n_cut += pairs.shape[1]
+        verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
+        segs, src = _cut(verts, segs, src, cuts)
+        verts, inverse = np.unique(verts, axis=0, return_inverse=True)
+        segs = inverse.reshape(-1)[segs]
+        segs, src = _split_at_vertices(verts, segs, src, None, tol)
+        segs, src = _drop_repeats(segs, src)
+    if n_cut and note is not None:
+        note.append(f"split segments at {n_cut} crossings")
+    return verts, segs, src
+
+
+def _cut(pts, segs, src, cuts):
+    """Replace each segment k in `cuts` by the chain through the vertices cuts[k],
+    ordered along it."""
     out_s, out_src = [], []
     for k in range(len(segs)):
+        if k not in cuts:
+            out_s.append(segs[k][None, :])
+            out_src.append([src[k]])
+            continue
         a, b = segs[k]
-        inner = sorted(set(cuts.get(k, ())),
-                       key=lambda v: float(np.dot(verts[v] - verts[a], verts[b] - verts[a])))
+        # order the cut points along the segment by the coordinate along which it runs
+        # furthest, then the other: comparing coordinates is exact, whereas a dot
+        # product would round away the order of points closer than its ulp
+        d = pts[b] - pts[a]
+        major = 0 if abs(d[0]) >= abs(d[1]) else 1
+        sign = np.where(d >= 0, 1.0, -1.0)
+        inner = sorted(set(cuts[k]) - {a, b},
+                       key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]))
         chain = [a, *inner, b]
         out_s.append(np.c_[chain[:-1], chain[1:]])
         out_src.append([src[k]] * (len(chain) - 1))
-    segs = np.concatenate(out_s)
-    src = np.concatenate([np.asarray(x) for x in out_src])
-    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
-    segs = inverse.reshape(-1)[segs]
-    segs, src = _split_at_vertices(uniq, segs, src, None)
-    segs, src = _drop_repeats(segs, src)
-    return uniq, segs, src
+    return (np.concatenate(out_s).astype(np.int64),
+            np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64))
 
 
 def _drop_repeats(segs, src):
@@ -240,45 +292,44 @@ def _drop_repeats(segs, src):
     return segs[first], src[first]
 
 
-def _split_at_vertices(pts, segs, src, note):
-    """Split each segment at the vertices lying exactly on its interior (decided with
-    the exact orientation predicate after a shapely candidate search)."""
+def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
+    """Split each segment at the vertices lying on its interior: exactly (decided with
+    the exact orientation predicate) or within `tol` of it (see snap_tolerance)."""
     from ._kernel import py_orient2d
     if len(segs) == 0:
         return segs, src
     lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
     # candidates: vertices within a tiny distance of a segment (shapely's own test may
     # miss a point that is exactly on the segment but not representable on its line)
-    tol = 1e-12 * float(np.abs(pts).max() + 1.0)
-    vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=tol)
+    reach = max(tol, 1e-12 * float(np.abs(pts).max() + 1.0))
+    vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
     cuts: dict[int, list[int]] = {}
+    neighbours = None
     for v, k in zip(vi.tolist(), si.tolist()):
         a, b = segs[k]
         if v == a or v == b:
             continue
         pa, pb, pv = pts[a], pts[b], pts[v]
-        if py_orient2d(pa[0], pa[1], pb[0], pb[1], pv[0], pv[1]) != 0:
+        if not (np.dot(pv - pa, pb - pa) > 0 and np.dot(pv - pb, pa - pb) > 0):
             continue
-        if np.dot(pv - pa, pb - pa) > 0 and np.dot(pv - pb, pa - pb) > 0:
-            cuts.setdefault(k, []).append(v)
+        if py_orient2d(pa[0], pa[1], pb[0], pb[1], pv[0], pv[1]) != 0:
+            d = pb - pa
+            cross = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
+            if not abs(cross) <= tol * float(np.hypot(d[0], d[1])):
+                continue
+            # near, not on: but a vertex joined to a or b by a segment is the far end
+            # of a needle there (a spike an ulp wide is still a valid polygon), and
+            # splitting would fold the needle onto the segment
+            if neighbours is None:
+                neighbours = {(int(x), int(y)) for x, y in segs} | {(int(y), int(x)) for x, y in segs}
+            if (v, int(a)) in neighbours or (v, int(b)) in neighbours:
+                continue
+        cuts.setdefault(k, []).append(v)
     if not cuts:
         return segs, src
     if note is not None:
         note.append(f"split {len(cuts)} segments at vertices lying on them")
-    out_s, out_src = [], []
-    for k in range(len(segs)):
-        if k not in cuts:
-            out_s.append(segs[k][None, :])
-            out_src.append([src[k]])
-            continue
-        a, b = segs[k]
-        d = pts[b] - pts[a]
-        inner = sorted(set(cuts[k]), key=lambda v: float(np.dot(pts[v] - pts[a], d)))
-        chain = [a, *inner, b]
-        out_s.append(np.c_[chain[:-1], chain[1:]])
-        out_src.append([src[k]] * (len(chain) - 1))
-    return (np.concatenate(out_s).astype(np.int64),
-            np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64))
+    return _cut(pts, segs, src, cuts)
 
 
 def _from_dict(d: dict) -> Domain:
@@ -319,8 +370,13 @@ def _from_dict(d: dict) -> Domain:
                 f"segment_markers[{i}] = {int(markers[i])} is out of the int32 range")
         markers = markers.astype(np.int32)
     _refuse_crossings(pts, seg)
-    return Domain(pts, seg, src, [f"segments[{i}]" for i in range(len(seg))],
-                  holes=holes, region_points=reg, source_markers=markers)
+    names = [f"segments[{i}]" for i in range(len(seg))]
+    # a segment running exactly through another vertex is split there now, before the
+    # size splits it into pieces whose rounded ends would miss that vertex
+    note: list[str] = []
+    seg, src = _split_at_vertices(pts, seg, src, note)
+    return Domain(pts, np.asarray(seg, dtype=np.int32), np.asarray(src, dtype=np.int32), names,
+                  holes=holes, region_points=reg, source_markers=markers, cleanup=note)
 
 
 def _refuse_crossings(pts, seg):
@@ -338,6 +394,23 @@ def _refuse_crossings(pts, seg):
             f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
             f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
             f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})", (i, j))
+
+
+def _outside_by_rounding(outside, union, tol: float) -> bool:
+    """Whether the parts of a constraint line outside the domain are there only by
+    rounding (a line ending on the boundary at a computed point, which the noding
+    then puts on the boundary): each part's ends and middle lie within `tol` of the
+    domain.  (A straight part whose ends and middle are that near a polygon is that
+    near it all along, unless the polygon has a feature right there, which the line
+    would then cross, splitting the part.)"""
+    parts = [p for p in shapely.get_parts(outside) if not p.is_empty]
+    probes = []
+    for p in parts:
+        c = shapely.get_coordinates(p)
+        probes.extend([c[0], c[-1], 0.5 * (c[0] + c[-1])])
+    if not probes:
+        return True
+    return bool((shapely.distance(union, shapely.points(np.array(probes))) <= tol).all())
 
 
 def to_domain(domain, *, keep_vertices: bool = False) -> Domain:
@@ -377,11 +450,14 @@ def _to_domain(domain, keep_vertices: bool) -> Domain:
         for k, p in enumerate(polygons):
             _check_polygon(p, names[k])
         union = shapely.union_all(polygons)
+        tol = None
         for k, line in enumerate(lines):
-            # covered, or outside by no more than rounding (a line ending on the
-            # boundary at a rounded point)
-            if not (union.covers(line)
-                    or line.difference(union).length <= 1e-9 * max(line.length, 1e-300)):
+            if union.covers(line):
+                continue
+            if tol is None:
+                tol = snap_tolerance(np.concatenate(
+                    [shapely.get_coordinates(g) for g in (*polygons, *lines)]))
+            if not _outside_by_rounding(line.difference(union), union, tol):
                 raise InvalidDomainError(f"constraint line {k} is not inside the domain")
         for k, p in enumerate(points):
             if not union.covers(p):

@@ -10,7 +10,7 @@ import shapely
 from .aft import Strategy, basic_aft
 from .boundary import discretize
 from .cdt import segment_markers
-from .domain import to_domain
+from .domain import node_crossings, snap_tolerance, to_domain
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
                      InvalidSizeError)
 from .mesh import Mesh
@@ -73,6 +73,16 @@ def _expected_triangles(field, area: float, gradation: float) -> float:
         return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area) * 1.2)
 
 
+def _name_sources(err: CrossingSegmentsError, dom, verts, segs, src) -> CrossingSegmentsError:
+    """The same error naming the user's segments / rings, not the pieces the
+    discretization made of them."""
+    names = [dom.source_names[src[k]] for k in err.segments if 0 <= k < len(src)]
+    where = [verts[segs[k]].tolist() for k in err.segments if 0 <= k < len(src)]
+    detail = " and ".join(f"{n} (near {w[0]} -> {w[1]})" for n, w in zip(names, where))
+    return CrossingSegmentsError(f"these input edges cross: {detail}",
+                                 tuple(int(src[k]) for k in err.segments))
+
+
 def _real(name, value, error=InvalidOptionError) -> float:
     """A finite real number from an option value, or an error naming the option."""
     if isinstance(value, (bool, np.bool_)) or isinstance(value, (str, bytes)):
@@ -129,7 +139,9 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     size : float, callable, sequence or None
         Target edge length: a number, ``f(x, y) -> array`` (called on whole arrays), one
         number per region (with a sequence of polygons as the domain), or None to take
-        it from the lengths of the input edges.
+        it from the lengths of the input edges.  A size must span at least 64 units in
+        the last place of the largest coordinate (about 1e-14 of it); a finer one
+        raises InvalidSizeError.
     max_triangles : int, optional
         N_max: the mesh never has more triangles (formula (4) of the paper).
     min_area : float, optional
@@ -230,16 +242,31 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         verts, segs, src = dom.vertices, dom.segments, dom.segment_source
     t_boundary = time.perf_counter()
     nt_hint = int(min(4e8, expected + 4 * len(verts)))
-    try:
-        built = build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
-                          nt_hint=min(nt_hint, 50_000_000))
-    except CrossingSegmentsError as err:
-        # name the user's segments / rings, not the pieces the discretization made
-        names = [dom.source_names[src[k]] for k in err.segments if 0 <= k < len(src)]
-        where = [verts[segs[k]].tolist() for k in err.segments if 0 <= k < len(src)]
-        detail = " and ".join(f"{n} (near {w[0]} -> {w[1]})" for n, w in zip(names, where))
-        raise CrossingSegmentsError(f"these input edges cross: {detail}",
-                                    tuple(int(src[k]) for k in err.segments)) from None
+
+    def build(verts, segs):
+        try:
+            return build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
+                             nt_hint=min(nt_hint, 50_000_000))
+        except CrossingSegmentsError as err:
+            return err
+
+    built = build(verts, segs)
+    if split_boundary and (isinstance(built, CrossingSegmentsError) or built.n_split):
+        # The domain's edges were noded before the discretization (and a dict's
+        # crossings refused), so a crossing now, or a piece running exactly through
+        # another vertex, comes from a rounded split point put on or across a segment
+        # passing within an ulp or two of it: discretize again without such points.
+        verts, segs, src = discretize(dom.vertices, dom.segments, dom.segment_source, field,
+                                      clear=snap_tolerance(dom.vertices))
+        dom.cleanup.append("left out split points within rounding of other segments")
+        built = build(verts, segs)
+    if isinstance(built, CrossingSegmentsError):
+        # What remains crosses by the rounding of the pieces themselves (two segments
+        # apart only at a grazing angle): node those pieces too, and try once more.
+        verts, segs, src = node_crossings(verts, segs, src, dom.cleanup)
+        built = build(verts, segs)
+        if isinstance(built, CrossingSegmentsError):
+            raise _name_sources(built, dom, verts, segs, src) from None
     kernel = built.kernel
     if dom.polygons is not None:
         comp, probes = kernel.components()

@@ -25,8 +25,7 @@ from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 # The exact predicates are exact for coordinates that are 0 or of magnitude between
 # these bounds (beyond, intermediate products could overflow or underflow; see
 # cython_ext/predicates.pxi): other coordinates are refused with a message saying so.
-MAX_COORDINATE = 1e75
-MIN_COORDINATE = 1e-57
+MIN_COORDINATE, MAX_COORDINATE = _kernel.EXACT_COORDINATE_RANGE
 
 
 @dataclass
@@ -36,6 +35,7 @@ class BuiltCDT:
     segments: np.ndarray        # (m, 2) segments in input vertex numbering
     merged: np.ndarray          # (n,) input vertex -> kernel vertex it was merged into
     n_merged: int
+    n_split: int = 0            # segments that ran exactly through another vertex
 
 
 def as_points(value, name: str) -> np.ndarray:
@@ -168,7 +168,7 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     n_merged = int((merged != np.arange(n)).sum())
     kseg = merged[seg] if len(seg) else seg
     try:
-        kernel.insert_segments(np.ascontiguousarray(kseg, dtype=np.int32))
+        n_split = kernel.insert_segments(np.ascontiguousarray(kseg, dtype=np.int32))
     except _kernel.CrossingError as err:
         i = err.index
         j = _segment_containing(pts, seg, *err.blocker)
@@ -197,4 +197,4 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     if len(reg):
         kernel.assign_regions(np.ascontiguousarray(reg[:, :2]),
                               np.ascontiguousarray(reg[:, 2].astype(np.int32)))
-    return BuiltCDT(kernel, pts, seg, merged, n_merged)
+    return BuiltCDT(kernel, pts, seg, merged, n_merged, n_split)

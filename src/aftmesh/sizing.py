@@ -22,6 +22,11 @@ __all__ = ["SizeField", "make_size_field"]
 # The background grid has at most this many nodes along its longer side.
 MAX_GRID = 512
 DEFAULT_GRADATION = 1.3
+# A user's size must span at least this many units in the last place of the domain's
+# largest coordinate: new vertices are rounded to the nearest double, by up to half a
+# unit per coordinate, so below this the mesh could not have the size asked for (and
+# at a few units, the points that split an edge would coincide).
+MIN_SIZE_ULPS = 64
 
 
 @dataclass(frozen=True)
@@ -67,6 +72,20 @@ def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> Non
             "sizes must be finite and positive")
 
 
+def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
+    """Refuse sizes finer than the coordinates can resolve (see MIN_SIZE_ULPS)."""
+    magnitude = float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))
+    spacing = float(np.spacing(magnitude))
+    k = int(np.argmin(h))
+    if h.ravel()[k] < MIN_SIZE_ULPS * spacing:
+        where = "" if X is None else f" at ({X.ravel()[k]:.9g}, {Y.ravel()[k]:.9g})"
+        raise InvalidSizeError(
+            f"{what} {h.ravel()[k]:.6g}{where} is below what the coordinates can resolve: "
+            f"near {magnitude:.6g}, doubles are {spacing:.3g} apart, and a size must span at "
+            f"least {MIN_SIZE_ULPS} of those ({MIN_SIZE_ULPS * spacing:.3g}); use a larger "
+            "size or move the domain nearer the origin")
+
+
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     try:
         out = size(X, Y)
@@ -90,6 +109,8 @@ def per_region_size(polygons, sizes):
 
     values = []
     for k, v in enumerate(sizes):
+        if isinstance(v, (bool, np.bool_, str, bytes)):
+            raise InvalidSizeError(f"size[{k}] = {v!r} is not a number")
         try:
             v = float(v)
         except (TypeError, ValueError):
@@ -165,6 +186,10 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
     if gradation is None or not np.isfinite(gradation) or gradation < 1.0:
         raise InvalidSizeError(f"gradation must be a finite number >= 1, got {gradation!r}")
     constant = None
+    if isinstance(size, (bool, np.bool_, str, bytes)):
+        # float() would take True as 1 and "0.1" as 0.1: almost surely a mistake
+        raise InvalidSizeError(
+            f"size must be a number, a callable f(x, y) or None, got {size!r}")
     if size is not None and not callable(size):
         try:
             constant = float(size)
@@ -173,6 +198,7 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
                 f"size must be a number, a callable f(x, y) or None, got {size!r}") from None
         if not (np.isfinite(constant) and constant > 0):
             raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
+        _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
     if constant is not None and (not have_boundary
                                  or float(np.min(boundary_lengths)) >= 0.8 * constant):
@@ -191,14 +217,20 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
         # a coarse look first, to pick a grid spacing fine enough for the smallest size
         x0, y0, dx, dy, X, Y = _grid(bounds, span / 64)
         h0 = _evaluate(size, X, Y)
+        _check_resolution(h0, X, Y, bounds, "the size callable gave")
         spacing = min(spacing, 0.5 * float(h0.min()))
     x0, y0, dx, dy, X, Y = _grid(bounds, spacing)
     if callable(size):
         h = _evaluate(size, X, Y)
+        _check_resolution(h, X, Y, bounds, "the size callable gave")
     elif constant is not None:
         h = np.full(X.shape, constant)
     else:
         h = np.full(X.shape, np.inf)
+    # the growth rate used to spread the boundary's sizes: the user's gradation, or
+    # the default one if the user asked for none (size=None with gradation=1 would
+    # otherwise leave the field infinite away from the boundary)
+    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
     if have_boundary:
         pts = np.asarray(boundary_points, dtype=np.float64)
         lengths = np.asarray(boundary_lengths, dtype=np.float64)
@@ -206,15 +238,14 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
         # out to the four grid nodes around it (not the bare length: a cell is much
         # larger than a tiny edge, and bilinear interpolation would spread that tiny
         # size over the whole cell)
-        rate = (gradation if gradation > 1.0 else DEFAULT_GRADATION) - 1.0
+        rate = spread - 1.0
         i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
         j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)
         for di in (0, 1):
             for dj in (0, 1):
                 dist = np.hypot(X[j + dj, i + di] - pts[:, 0], Y[j + dj, i + di] - pts[:, 1])
                 np.minimum.at(h, (j + dj, i + di), lengths + rate * dist)
-    h = limit_gradation(h, dx, dy, gradation if gradation > 1.0 else DEFAULT_GRADATION
-                        if not np.isfinite(h).all() else gradation)
+    h = limit_gradation(h, dx, dy, spread if not np.isfinite(h).all() else gradation)
     if not np.isfinite(h).all():
         raise InvalidSizeError("could not derive a size from the boundary")
     return SizeField(float(x0), float(y0), float(dx), float(dy), np.ascontiguousarray(h))
