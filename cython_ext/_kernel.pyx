@@ -252,16 +252,19 @@ cdef class Triangulation:
     def components(self):
         """Split the domain triangles into the pieces that segments separate.
 
-        Returns (comp, probe): comp[t] is the piece of triangle slot t (-1 if t is not
-        a domain triangle) and probe[c] = (x, y) a point well inside piece c: the
+        Returns (comp, probe, corners): comp[t] is the piece of triangle slot t (-1 if
+        t is not a domain triangle), probe[c] = (x, y) a point well inside piece c: the
         centroid of its triangle with the largest area, so that classifying probe[c]
-        against the user's polygons classifies the whole piece."""
+        against the user's polygons classifies the whole piece, and corners[c] (3, 2)
+        that triangle's corners (the rounded centroid of a triangle an ulp or two wide
+        may not be inside it: the caller checks)."""
         cdef Tri* T = &self.T
-        cdef int t, k, e, u, sp, nc = 0
+        cdef int t, k, e, u, sp, nc = 0, best_t = 0
         cdef double area
         comp_arr = np.full(T.nt, -1, dtype=np.int32)
         cdef int32_t[::1] comp = comp_arr
         best = []
+        corners = []
         if reserve_stack(T, T.nt + 1):
             raise MemoryError()
         for t in range(T.nt):
@@ -279,6 +282,7 @@ cdef class Triangulation:
                 if area > best_area:
                     best_area = area
                     best_xy = _centroid(T, u)
+                    best_t = u
                 for k in range(3):
                     e = 3 * u + k
                     if T.eflag[e] & E_SEGMENT:
@@ -289,8 +293,11 @@ cdef class Triangulation:
                         T.stack[sp] = e
                         sp += 1
             best.append(best_xy)
+            corners.append([(P(T, T.tv[3 * best_t + k])[0], P(T, T.tv[3 * best_t + k])[1])
+                            for k in range(3)])
             nc += 1
-        return comp_arr, np.array(best, dtype=np.float64).reshape(-1, 2)
+        return (comp_arr, np.array(best, dtype=np.float64).reshape(-1, 2),
+                np.array(corners, dtype=np.float64).reshape(-1, 3, 2))
 
     def set_regions(self, const int32_t[::1] comp, const int32_t[::1] region_of_comp):
         """Give every domain triangle the region of its piece (see components());

@@ -5,6 +5,7 @@ every run tries the same examples), ``long`` (many more examples, for fuzzing
 sessions; failures found there are pinned as named regression tests).
 """
 import os
+import signal
 
 import numpy as np
 import pytest
@@ -33,3 +34,15 @@ def checked():
         check_mesh(mesh, **kw)
         return mesh
     return run
+
+
+@pytest.fixture
+def default_sigint():
+    """Python's own SIGINT handler (KeyboardInterrupt) for the test's duration: a test
+    run started as a background job of a non-interactive shell inherits SIGINT
+    ignored, and Python then never installs that handler."""
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, old)

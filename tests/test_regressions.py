@@ -183,6 +183,7 @@ def test_ctrl_c_ignored_during_smoothing():
     test uses the cap.)"""
     def run():
         state = {}
+        signal.signal(signal.SIGINT, signal.default_int_handler)  # even if inherited ignored
 
         def fire():
             time.sleep(0.5)
@@ -494,11 +495,10 @@ def test_gap_of_a_few_ulps_far_from_origin_is_not_closed(checked):
     and closed the gap, bending the boundary by 2.98e-8 ('mesh segment point ... is
     2.98e-08 away from every input edge'); the tolerance is now 2 ulps, the rounding of
     a computed point.  Found by the fuzzer (walk+offset)."""
-    ring = [[71066330.76221266, -71066330.08782011], [71066331.4934162, -71066330.22925001],
-            [71066331.26221254, -71066329.77443752], [71066331.68696073, -71066330.26221254],
+    # the fuzzer's 11-vertex polygon, cut down to the vertices that keep the failure
+    ring = [[71066330.76221266, -71066330.08782011], [71066331.68696073, -71066330.26221254],
             [71066330.92969792, -71066330.26221254], [71066330.87220481, -71066330.12522256],
-            [71066330.7622126, -71066330.61966804], [71066331.6997911, -71066330.41034773],
-            [71066331.43241991, -71066330.52795883], [71066331.46262462, -71066330.76221243],
+            [71066330.7622126, -71066330.61966804], [71066331.46262462, -71066330.76221243],
             [71066330.76221254, -71066330.76221254]]
     poly = Polygon(ring)
     case = fd.FuzzCase("walk+offset", np.array(ring), None,
@@ -531,26 +531,17 @@ def test_crossing_points_closer_than_a_dot_products_ulp_ordered_exactly(checked)
 
 
 def test_needle_an_ulp_wide_keeps_its_tip_when_split(checked):
-    """A random-walk polygon at the 1e-6 scale with a needle whose sides are 1.5 ulps
-    apart at its base.  Split for the size, every point of the slanted side rounds onto
-    the other side's line, so the CDT split that side at them, the needle folded, and
+    """A quadrilateral at the 1e-6 scale with a needle whose sides are 1.5 ulps apart
+    at its base.  Split for the size, every point of the slanted side rounds onto the
+    other side's line, so the CDT split that side at them, the needle folded, and
     its tip vanished from the mesh ('input corner (2.852e-07, 1e-06) is not a mesh
     vertex'; the area, 1e-29 less, passed).  The kernel now reports segments split at
     vertices, and generate discretizes again without points that near another
     segment.  Found by the fuzzer (walk+small)."""
-    ring = [[3.365591503278354e-08, 9.999999999999997e-07], [2.8521983272121794e-07, 9.999999999999997e-07],
-            [6.103515625e-11, 1e-06], [3.1674308885637164e-07, 5.777133618857241e-07],
-            [2.8307677230474166e-07, 4.6516809204126516e-07], [1.8810652526464105e-07, 4.1233067142958254e-07],
-            [2.0506592346896916e-07, 2.438754591477639e-07], [5.944269154557481e-08, 6.786467533946002e-07],
-            [0.0, 9e-07], [1.2244750328600287e-08, 8.314294512989135e-07], [1e-08, 5.747665969808581e-10],
-            [2.2825022669867483e-07, 1e-15], [2.8208801168840887e-07, 0.0],
-            [5.947544962168446e-07, 9.562273431928417e-08], [3.957667256828735e-07, 3.3757317098125885e-07],
-            [8.739637673251436e-07, 0.0], [9.866719170190173e-07, 5.960464477539062e-14],
-            [7.172939875172807e-07, 3.591666631337065e-07], [8e-07, 7.050797155870397e-07],
-            [8.247591710380309e-07, 7.715719962420504e-07], [7.589706357580982e-07, 8.366352297394527e-07],
-            [5e-07, 8.160423708849393e-07], [4.829580031870927e-07, 5.93929950787107e-07],
-            [4.5360759708002493e-07, 8.149196246897969e-07], [3.260876812422793e-07, 6.627654590875148e-07],
-            [1.6261346477560148e-07, 7.894636442165441e-07]]
+    # the needle of the fuzzer's 26-vertex polygon, closed by one more vertex
+    y = 9.999999999999997e-07
+    ring = [(3.365591503278354e-08, y), (2.8521983272121794e-07, y), (6.103515625e-11, 1e-06),
+            (1e-7, 5e-7)]
     poly = Polygon(ring)
     assert poly.is_valid
     case = fd.FuzzCase("walk+small", poly, 7.024103985267414e-08, {}, [poly])
@@ -575,3 +566,63 @@ def test_dict_segment_through_a_vertex_split_before_discretization(checked):
     # pieces of segment 0: both ends on the line y = x / 3 (exact for these points)
     on0 = (3 * P[S[:, 0], 1] == P[S[:, 0], 0]) & (3 * P[S[:, 1], 1] == P[S[:, 1], 0])
     assert on0.any() and (markers[on0] == 7).all()
+
+
+def test_hole_an_ulp_from_the_outer_ring_is_not_snapped_onto_it(checked):
+    """A square at 1e7 with a diamond hole whose left corner is 1 ulp (1.86e-9) right
+    of the square's left side.  Snapping every vertex within 2 ulps of a segment split
+    that side at the hole's corner, closing the gap: with split_boundary=False the
+    input edge was no longer a mesh segment.  Only free ends of lines (and lone points)
+    are snapped now; a ring's corner stays where it is.  Found by the fuzzer
+    (near-hole-to-edge+offset)."""
+    hole = [(10000000.000000002, -9999999.0), (10000000.5, -9999999.05),
+            (10000001.0, -9999999.0), (10000000.5, -9999998.95)]
+    poly = Polygon([(1e7, -1e7), (10000002.0, -1e7), (10000002.0, -9999998.0), (1e7, -9999998.0)],
+                   [hole])
+    for split in (False, True):
+        case = fd.FuzzCase("near-hole-to-edge+offset", poly, 0.385, {"split_boundary": split},
+                           [poly])
+        mesh = case.call()
+        fd.verify(mesh, case, check=checked)
+        assert not any("vertices lying on them" in c for c in mesh.info["cleanup"])
+
+
+def test_vertex_within_rounding_of_a_piece_keeps_its_side(checked):
+    """A needle at the unit scale: its tip at y = 1 - 2**-53, one side flat, the other
+    rising to y = 1.  The flat side's far end (0.484, 1 - 2**-53) is 0.2 ulp below the
+    rising side; the points splitting the rising side all round to y = 1 - 2**-53 or
+    1, so the piece from the tip to the first of them ran exactly through that end,
+    the needle folded and its tip was lost ('input corner (0.369, 0.9999999999999999)
+    is not a mesh vertex').  Split points are now left out until every vertex that
+    near a segment is on the same side of its pieces as of the segment (exact
+    orientation).  Found by the fuzzer (walk)."""
+    e = 0.9999999999999999
+    ring = [(0.3691182857977418, e), (0.8963404525622876, 1.0), (0.5, 0.3),
+            (0.48404463285669996, e)]
+    poly = Polygon(ring)
+    assert poly.is_valid
+    case = fd.FuzzCase("walk", poly, 0.053612085881384566, {}, [poly])
+    mesh = case.call()
+    fd.verify(mesh, case, check=checked)
+
+
+def test_triangle_one_ulp_squared_far_from_origin_is_meshed(checked):
+    """A triangle with corners (0, 0), (0, 2), (1, 1) in ulps of 6.4e7 (area 1 ulp²,
+    5.6e-17): no double lies strictly inside it, so the rounded centroid used to
+    classify the CDT's piece against the polygon fell outside and generate said 'the
+    domain encloses no area'.  A probe that is not strictly inside its triangle (exact
+    test) is replaced by the exact rational centroid, classified by an exact even-odd
+    test.  Found by the fuzzer (extreme+offset)."""
+    x0 = 64206807.7535527
+    u = float(np.spacing(x0))
+    y0 = -x0 - u
+    ring = [(x0, y0), (x0 + u, y0 + u), (x0, y0 + 2 * u)]
+    poly = Polygon(ring)
+    assert poly.is_valid and poly.area > 0
+    for split in (True, False):
+        mesh = checked(aftmesh.generate(poly, split_boundary=split), domain_area=poly.area,
+                       area_rtol=1e-12)
+        assert len(mesh.triangles) == 1
+    # the same through a region list (the region index comes from the same test)
+    mesh = checked(aftmesh.generate([poly]), domain_area=poly.area, area_rtol=1e-12)
+    assert np.asarray(mesh.regions).tolist() == [0]

@@ -23,11 +23,12 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     Raises InvalidSizeError, before allocating anything, if the boundary alone would
     need more than `max_pieces` edges (each is a side of a triangle of the mesh).
 
-    With `clear` > 0, a split point within that distance of another segment is left
-    out.  A split point is rounded, so where two segments are within an ulp or two of
-    each other (the sides of a needle, a line grazing an edge) it may land on the
-    other segment or beyond it, which would change the PSLG's topology; leaving it out
-    only makes a piece longer than the size asks for."""
+    With `clear` > 0, split points are left out where rounding could change the
+    PSLG's topology: a split point within that distance of another segment (it may
+    land on that segment or beyond it: the sides of a needle, a line grazing an edge),
+    and the ends of a piece that would put a vertex lying that near the segment on the
+    other side of it, or on it.  Leaving points out only makes a piece longer than the
+    size asks for."""
     if len(segments) == 0:
         return vertices, segments, source
     a = vertices[segments[:, 0]]
@@ -65,6 +66,7 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
         points.append(a[k] + np.outer(t, b[k] - a[k]))
     if clear > 0 and points:
         points = _clear_of_others(points, split, a, b, clear)
+        points = _keep_sides(points, split, vertices, segments, clear)
     new_vertices = [vertices]
     new_segments = []
     new_source = []
@@ -107,3 +109,52 @@ def _clear_of_others(points, split, a, b, clear):
         out.append(p[keep[start:start + len(p)]])
         start += len(p)
     return out
+
+
+def _keep_sides(points, split, vertices, segments, clear):
+    """Leave out split points until every input vertex within `clear` of a split
+    segment is on the same side of each nearby piece as of the segment (decided by
+    the exact orientation predicate; the segment itself, unsplit, always qualifies)."""
+    import shapely
+    from ._kernel import py_orient2d
+    where = {int(k): i for i, k in enumerate(split)}
+    a = vertices[segments[split, 0]]
+    b = vertices[segments[split, 1]]
+    lines = shapely.linestrings(np.stack([a, b], axis=1))
+    vi, li = shapely.STRtree(lines).query(shapely.points(vertices), predicate="dwithin",
+                                          distance=clear)
+    out = list(points)
+    for v, i in zip(vi.tolist(), li.tolist()):
+        k = int(split[i])
+        if v in (segments[k, 0], segments[k, 1]):
+            continue
+        pv = vertices[v]
+        side = py_orient2d(a[i, 0], a[i, 1], b[i, 0], b[i, 1], pv[0], pv[1])
+        if side == 0:
+            continue        # on the segment: the CDT splits it there, as it would unsplit
+        pts = out[where[k]]
+        changed = True
+        while changed and len(pts):
+            changed = False
+            chain = np.vstack([a[i], pts, b[i]])
+            for j in range(len(chain) - 1):
+                p, q = chain[j], chain[j + 1]
+                if _distance(pv, p, q) > 2 * clear:
+                    continue
+                if py_orient2d(p[0], p[1], q[0], q[1], pv[0], pv[1]) != side:
+                    # drop the piece's split-point ends (chain[0] and chain[-1] are the
+                    # segment's own ends) and look again
+                    drop = [m - 1 for m in (j, j + 1) if 0 < m < len(chain) - 1]
+                    pts = np.delete(pts, drop, axis=0)
+                    changed = True
+                    break
+        out[where[k]] = pts
+    return out
+
+
+def _distance(p, a, b) -> float:
+    """Distance from point p to segment a-b (floating point, for a proximity test)."""
+    d = b - a
+    L2 = float(np.dot(d, d))
+    t = 0.0 if L2 == 0 else min(1.0, max(0.0, float(np.dot(p - a, d)) / L2))
+    return float(np.hypot(*(a + t * d - p)))

@@ -304,7 +304,7 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
     reach = max(tol, 1e-12 * float(np.abs(pts).max() + 1.0))
     vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
     cuts: dict[int, list[int]] = {}
-    neighbours = None
+    degree = np.bincount(np.asarray(segs).ravel(), minlength=len(pts))
     for v, k in zip(vi.tolist(), si.tolist()):
         a, b = segs[k]
         if v == a or v == b:
@@ -317,12 +317,13 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
             cross = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
             if not abs(cross) <= tol * float(np.hypot(d[0], d[1])):
                 continue
-            # near, not on: but a vertex joined to a or b by a segment is the far end
-            # of a needle there (a spike an ulp wide is still a valid polygon), and
-            # splitting would fold the needle onto the segment
-            if neighbours is None:
-                neighbours = {(int(x), int(y)) for x, y in segs} | {(int(y), int(x)) for x, y in segs}
-            if (v, int(a)) in neighbours or (v, int(b)) in neighbours:
+            # near, not on: only the free end of a line (or a lone point) is meant to
+            # be on the segment, as in a crack ending on the boundary at a computed
+            # point.  A vertex with two segments is a corner of a valid ring or a
+            # bend of a line, an ulp off on purpose or not: snapping it would close a
+            # gap (a hole an ulp from the outer ring) or fold a needle, so it stays
+            # (generate drops split points that near it, see boundary.discretize).
+            if degree[v] > 1:
                 continue
         cuts.setdefault(k, []).append(v)
     if not cuts:
@@ -394,6 +395,57 @@ def _refuse_crossings(pts, seg):
             f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
             f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
             f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})", (i, j))
+
+
+def classify_pieces(polygons, probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """The index of the polygon each piece of the CDT lies in (-1: none), from a point
+    inside one of its triangles (see Triangulation.components).  The probe is that
+    triangle's rounded centroid; for a triangle an ulp or two wide it may fall on an
+    edge or outside, and no double may lie inside it at all, so such a piece is
+    classified by its exact rational centroid instead (see _exact_inside)."""
+    from ._kernel import py_orient2d
+    region_of = np.full(len(probes), -1, dtype=np.int32)
+    for k, poly in enumerate(polygons):
+        inside = shapely.contains_xy(poly, probes[:, 0], probes[:, 1])
+        region_of[inside & (region_of < 0)] = k
+    for c in range(len(probes)):
+        (ax, ay), (bx, by), (cx, cy) = corners[c]
+        x, y = probes[c]
+        side = py_orient2d(ax, ay, bx, by, cx, cy)
+        if side != 0 and py_orient2d(ax, ay, bx, by, x, y) == side \
+                and py_orient2d(bx, by, cx, cy, x, y) == side \
+                and py_orient2d(cx, cy, ax, ay, x, y) == side:
+            continue            # the probe is strictly inside its triangle
+        region_of[c] = -1
+        for k, poly in enumerate(polygons):
+            if _exact_inside(poly, corners[c]):
+                region_of[c] = k
+                break
+    return region_of
+
+
+def _exact_inside(poly, corners: np.ndarray) -> bool:
+    """Whether the exact centroid of the triangle `corners` is inside `poly` (even-odd
+    rule over all its rings, in rational arithmetic).  The centroid is strictly inside
+    a triangle of the CDT, so it is on no ring."""
+    from fractions import Fraction
+    lo, hi = corners.min(axis=0), corners.max(axis=0)
+    x0, y0, x1, y1 = poly.bounds
+    if lo[0] < x0 or lo[1] < y0 or hi[0] > x1 or hi[1] > y1:
+        return False
+    px = sum(Fraction(float(v)) for v in corners[:, 0]) / 3
+    py = sum(Fraction(float(v)) for v in corners[:, 1]) / 3
+    inside = False
+    for part in shapely.get_parts(poly):
+        for ring in [part.exterior, *part.interiors]:
+            c = np.asarray(ring.coords)[:, :2]
+            for (xa, ya), (xb, yb) in zip(c[:-1].tolist(), c[1:].tolist()):
+                if (ya > py) != (yb > py):
+                    x = Fraction(xa) + (py - Fraction(ya)) * (Fraction(xb) - Fraction(xa)) \
+                        / (Fraction(yb) - Fraction(ya))
+                    if px < x:
+                        inside = not inside
+    return inside
 
 
 def _outside_by_rounding(outside, union, tol: float) -> bool:

@@ -10,7 +10,7 @@ import shapely
 from .aft import Strategy, basic_aft
 from .boundary import discretize
 from .cdt import segment_markers
-from .domain import node_crossings, snap_tolerance, to_domain
+from .domain import classify_pieces, node_crossings, snap_tolerance, to_domain
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
                      InvalidSizeError)
 from .mesh import Mesh
@@ -269,12 +269,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
             raise _name_sources(built, dom, verts, segs, src) from None
     kernel = built.kernel
     if dom.polygons is not None:
-        comp, probes = kernel.components()
-        region_of = np.full(len(probes), -1, dtype=np.int32)
-        for k, poly in enumerate(dom.polygons):
-            inside = shapely.contains_xy(poly, probes[:, 0], probes[:, 1])
-            region_of[inside & (region_of < 0)] = k
-        kernel.set_regions(comp, region_of)
+        comp, probes, corners = kernel.components()
+        kernel.set_regions(comp, classify_pieces(dom.polygons, probes, corners))
     n_ext, n_unmeshed, _ = kernel.state_counts()
     if n_unmeshed == 0:
         raise InvalidDomainError(
