@@ -626,3 +626,23 @@ def test_triangle_one_ulp_squared_far_from_origin_is_meshed(checked):
     # the same through a region list (the region index comes from the same test)
     mesh = checked(aftmesh.generate([poly]), domain_area=poly.area, area_rtol=1e-12)
     assert np.asarray(mesh.regions).tolist() == [0]
+
+
+def test_region_two_ulps_wide_labelled_and_checked_exactly(checked):
+    """Regions side by side, the middle one a strip 2 ulps wide (0.9499999999999998 to
+    0.95).  Its triangles' rounded centroids land on the strip's edges, so the oracle's
+    point-in-polygon test called them outside their region although they were inside
+    (checked exactly).  The oracle now decides such triangles by the exact centroid
+    (winding number), and aftmesh classifies such pieces the same way.  Found by the
+    fuzzer (touch-regions, with swaps=False)."""
+    x = 0.9499999999999998
+    regions = [box(0.0, 0.0, x, 0.5), box(x, 0.0, 0.95, 0.5), box(0.95, 0.0, 1.0, 0.5)]
+    for opts in ({}, {"swaps": False, "gradation": 1.05}):
+        case = fd.FuzzCase("touch-regions", regions, 0.1, opts, regions)
+        mesh = case.call()
+        fd.verify(mesh, case, check=checked)
+        assert (np.asarray(mesh.regions) == 1).sum() > 0
+    # the oracle's exact test is not a rubber stamp
+    tri = np.array([[0.95, 0.1], [0.96, 0.1], [0.95, 0.11]])
+    assert fd._exact_winding_inside(regions[2], tri)
+    assert not fd._exact_winding_inside(regions[1], tri)

@@ -294,7 +294,8 @@ def _drop_repeats(segs, src):
 
 def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
     """Split each segment at the vertices lying on its interior: exactly (decided with
-    the exact orientation predicate) or within `tol` of it (see snap_tolerance)."""
+    the exact orientation predicate), or, for a vertex with at most one segment (a
+    line's free end, a lone point), within `tol` of it (see snap_tolerance)."""
     from ._kernel import py_orient2d
     if len(segs) == 0:
         return segs, src
