@@ -646,3 +646,24 @@ def test_region_two_ulps_wide_labelled_and_checked_exactly(checked):
     tri = np.array([[0.95, 0.1], [0.96, 0.1], [0.95, 0.11]])
     assert fd._exact_winding_inside(regions[2], tri)
     assert not fd._exact_winding_inside(regions[1], tri)
+
+
+def test_two_lines_ending_at_one_point_within_rounding_of_an_edge(checked):
+    """Two constraint lines ending at the same point, computed on a boundary edge and
+    1e-18 off it.  Snapping only vertices with one segment left this end (two
+    segments) off the edge; the edge's rounded split points then crossed the lines
+    (CrossingSegmentsError naming constraint line 0 and the exterior ring).  Any
+    vertex that is on no polygon ring is snapped now.  Found by the fuzzer
+    (constraints)."""
+    poly = Polygon([(0.016514367915341048, 0.04719402136242211),
+                    (-0.026080074013174682, -0.04265946248451018),
+                    (0.9276368212657233, -2.272054927868587e-16)])
+    end = (0.012254923722489475, 0.03820867297772888)
+    lines = [LineString([(0.032557692705115215, 0.0), end]), LineString([(0.0, 0.0), end])]
+    points = [Point(0.022406308213802344, 0.01910433648886444),
+              Point(0.006127461861244738, 0.01910433648886444)]
+    case = fd.FuzzCase("constraints", GeometryCollection([poly, *lines, *points]),
+                       0.03831761088376678, {}, [poly], lines, points)
+    mesh = case.call()
+    fd.verify(mesh, case, check=checked)
+    assert end in set(map(tuple, np.asarray(mesh.points).tolist()))

@@ -53,6 +53,7 @@ class Domain:
     area: float | None = None
     cleanup: list[str] = field(default_factory=list)
     source_markers: np.ndarray | None = None    # the user's marker of each source
+    ring_source: np.ndarray | None = None       # whether each source is a polygon ring
 
 
 def _is_coordinate_array(obj) -> bool:
@@ -143,6 +144,7 @@ def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: lis
     segments: list[np.ndarray] = []
     sources: list[np.ndarray] = []
     source_names: list[str] = []
+    ring_source: list[bool] = []
     offset = 0
 
     def add_chain(c: np.ndarray, closed: bool, name: str):
@@ -156,6 +158,7 @@ def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: lis
         segments.append(seg + offset)
         sources.append(np.full(len(seg), len(source_names)))
         source_names.append(name)
+        ring_source.append(closed)
         offset += n
 
     for k, poly in enumerate(polygons):
@@ -179,10 +182,11 @@ def _from_shapely(polygons: list[Polygon], lines: list, points: list, names: lis
     verts = np.concatenate(vertices) if vertices else np.zeros((0, 2))
     segs = np.concatenate(segments) if segments else np.zeros((0, 2), dtype=np.int64)
     src = np.concatenate(sources) if sources else np.zeros(0, dtype=np.int64)
-    verts, segs, src = _merge_and_node(verts, segs, src, note)
+    rings = np.array(ring_source, dtype=bool)
+    verts, segs, src = _merge_and_node(verts, segs, src, note, rings)
     union_area = float(shapely.union_all(polygons).area)
     return Domain(verts, segs.astype(np.int32), src.astype(np.int32), source_names,
-                  polygons=polygons, area=union_area, cleanup=note)
+                  polygons=polygons, area=union_area, cleanup=note, ring_source=rings)
 
 
 def snap_tolerance(pts: np.ndarray) -> float:
@@ -199,7 +203,7 @@ def snap_tolerance(pts: np.ndarray) -> float:
     return 2.0 * float(np.spacing(np.abs(pts).max()))
 
 
-def _merge_and_node(verts, segs, src, note):
+def _merge_and_node(verts, segs, src, note, ring_source):
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
     the outer ring, a T-junction between regions, a constraint line ending on a
@@ -208,9 +212,9 @@ def _merge_and_node(verts, segs, src, note):
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
     tol = snap_tolerance(uniq)
-    segs, src = _split_at_vertices(uniq, segs, src, note, tol)
+    segs, src = _split_at_vertices(uniq, segs, src, note, tol, ring_source)
     segs, src = _drop_repeats(segs, src)
-    return node_crossings(uniq, segs, src, note, tol)
+    return node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
 
 
 def _crossing_pairs(verts, segs):
@@ -219,7 +223,7 @@ def _crossing_pairs(verts, segs):
     return lines, pairs[:, pairs[0] < pairs[1]]
 
 
-def node_crossings(verts, segs, src, note, tol=None, rounds: int = 8):
+def node_crossings(verts, segs, src, note, tol=None, rounds: int = 8, ring_source=None):
     """Split the segments that cross each other at their crossing points, until none
     cross.  A crossing point is rounded, so it is not exactly on either segment, but
     within an ulp of both: the two pieces of each segment bend by that much at most,
@@ -252,7 +256,7 @@ def node_crossings(verts, segs, src, note, tol=None, rounds: int = 8):
         segs, src = _cut(verts, segs, src, cuts)
         verts, inverse = np.unique(verts, axis=0, return_inverse=True)
         segs = inverse.reshape(-1)[segs]
-        segs, src = _split_at_vertices(verts, segs, src, None, tol)
+        segs, src = _split_at_vertices(verts, segs, src, None, tol, ring_source)
         segs, src = _drop_repeats(segs, src)
     if n_cut and note is not None:
         note.append(f"split segments at {n_cut} crossings")
@@ -292,10 +296,12 @@ def _drop_repeats(segs, src):
     return segs[first], src[first]
 
 
-def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
+def _split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None):
     """Split each segment at the vertices lying on its interior: exactly (decided with
-    the exact orientation predicate), or, for a vertex with at most one segment (a
-    line's free end, a lone point), within `tol` of it (see snap_tolerance)."""
+    the exact orientation predicate), or, for a vertex on no polygon ring (a line's end
+    or bend, a lone point), within `tol` of it (see snap_tolerance).  ring_source[s]
+    says whether source s is a ring; without it, only vertices with at most one
+    segment are snapped."""
     from ._kernel import py_orient2d
     if len(segs) == 0:
         return segs, src
@@ -305,7 +311,12 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
     reach = max(tol, 1e-12 * float(np.abs(pts).max() + 1.0))
     vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
     cuts: dict[int, list[int]] = {}
-    degree = np.bincount(np.asarray(segs).ravel(), minlength=len(pts))
+    segs = np.asarray(segs)
+    if ring_source is None:
+        fixed = np.bincount(segs.ravel(), minlength=len(pts)) > 1
+    else:
+        fixed = np.zeros(len(pts), dtype=bool)
+        fixed[segs[ring_source[np.asarray(src)]].ravel()] = True
     for v, k in zip(vi.tolist(), si.tolist()):
         a, b = segs[k]
         if v == a or v == b:
@@ -318,13 +329,13 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0):
             cross = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
             if not abs(cross) <= tol * float(np.hypot(d[0], d[1])):
                 continue
-            # near, not on: only the free end of a line (or a lone point) is meant to
+            # near, not on: a constraint line's vertex (or a lone point) is meant to
             # be on the segment, as in a crack ending on the boundary at a computed
-            # point.  A vertex with two segments is a corner of a valid ring or a
-            # bend of a line, an ulp off on purpose or not: snapping it would close a
-            # gap (a hole an ulp from the outer ring) or fold a needle, so it stays
-            # (generate drops split points that near it, see boundary.discretize).
-            if degree[v] > 1:
+            # point.  A ring's corner is not: a valid polygon may have a hole an ulp
+            # from its outer ring or a needle an ulp wide, and snapping would close
+            # the gap or fold the needle, so it stays (generate drops split points
+            # that near it, see boundary.discretize).
+            if fixed[v]:
                 continue
         cuts.setdefault(k, []).append(v)
     if not cuts:

@@ -263,7 +263,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     if isinstance(built, CrossingSegmentsError):
         # What remains crosses by the rounding of the pieces themselves (two segments
         # apart only at a grazing angle): node those pieces too, and try once more.
-        verts, segs, src = node_crossings(verts, segs, src, dom.cleanup)
+        verts, segs, src = node_crossings(verts, segs, src, dom.cleanup,
+                                          ring_source=dom.ring_source)
         built = build(verts, segs)
         if isinstance(built, CrossingSegmentsError):
             raise _name_sources(built, dom, verts, segs, src) from None
