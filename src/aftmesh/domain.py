@@ -310,8 +310,10 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None)
     # miss a point that is exactly on the segment but not representable on its line)
     reach = max(tol, 1e-12 * float(np.abs(pts).max() + 1.0))
     vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
-    cuts: dict[int, list[int]] = {}
     segs = np.asarray(segs)
+    other = (vi != segs[si, 0]) & (vi != segs[si, 1])     # each segment finds its own ends
+    vi, si = vi[other], si[other]
+    cuts: dict[int, list[int]] = {}
     if ring_source is None:
         fixed = np.bincount(segs.ravel(), minlength=len(pts)) > 1
     else:
@@ -345,7 +347,7 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None)
     return _cut(pts, segs, src, cuts)
 
 
-def _from_dict(d: dict) -> Domain:
+def _from_dict(d: dict, presplit: bool = True) -> Domain:
     if "vertices" not in d:
         raise InvalidInputError("a domain dict needs 'vertices' (and usually 'segments')")
     pts = as_points(d["vertices"], "vertices")
@@ -385,9 +387,11 @@ def _from_dict(d: dict) -> Domain:
     _refuse_crossings(pts, seg)
     names = [f"segments[{i}]" for i in range(len(seg))]
     # a segment running exactly through another vertex is split there now, before the
-    # size splits it into pieces whose rounded ends would miss that vertex
+    # size splits it into pieces whose rounded ends would miss that vertex (kept whole,
+    # the CDT splits it there exactly, at no cost here)
     note: list[str] = []
-    seg, src = _split_at_vertices(pts, seg, src, note)
+    if presplit:
+        seg, src = _split_at_vertices(pts, seg, src, note)
     return Domain(pts, np.asarray(seg, dtype=np.int32), np.asarray(src, dtype=np.int32), names,
                   holes=holes, region_points=reg, source_markers=markers, cleanup=note)
 
@@ -489,12 +493,12 @@ def _to_domain(domain, keep_vertices: bool) -> Domain:
     if isinstance(domain, (str, PathLike)):
         from .io import read_poly
         try:
-            return _from_dict(read_poly(domain))
+            return _from_dict(read_poly(domain), presplit=not keep_vertices)
         except OSError as exc:
             # a wrong path is the caller's input error like any other
             raise InvalidInputError(f"cannot read the domain file {str(domain)!r}: {exc}") from None
     if isinstance(domain, dict):
-        return _from_dict(domain)
+        return _from_dict(domain, presplit=not keep_vertices)
     if isinstance(domain, shapely.Geometry):
         polygons, lines, points = [], [], []
         parts = shapely.get_parts(domain) if isinstance(domain, GeometryCollection) else [domain]
