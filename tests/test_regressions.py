@@ -667,3 +667,20 @@ def test_two_lines_ending_at_one_point_within_rounding_of_an_edge(checked):
     mesh = case.call()
     fd.verify(mesh, case, check=checked)
     assert end in set(map(tuple, np.asarray(mesh.points).tolist()))
+
+
+def test_boundary_edge_lengths_hold_next_to_the_boundary():
+    """The size field takes each boundary edge's length at the grid nodes around its
+    vertices.  Growing it at the gradation rate from the vertex itself (done against
+    tiny edges flooding a cell) made the field miss the boundary's sizes next to a
+    graded boundary: the naca0012 benchmark's mean radius ratio fell from 0.962 to
+    0.940 (found by re-running the benchmarks).  Now the length holds out to
+    BOUNDARY_REACH edge lengths and grows beyond, so a tiny edge still cannot flood a
+    cell."""
+    from aftmesh.sizing import BOUNDARY_REACH, make_size_field
+    bounds = ((0.0, 0.0), (100.0, 100.0))
+    f = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([0.5]))
+    assert f.dx > 0.1 and f.dx * np.sqrt(2) < BOUNDARY_REACH * 0.5   # nodes within reach
+    assert f(50.1, 50.1) == pytest.approx(0.5, rel=1e-12)
+    tiny = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([1e-6]))
+    assert tiny(50.1, 50.1) > 1e3 * 1e-6          # not spread over the whole cell

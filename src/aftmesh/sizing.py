@@ -27,6 +27,9 @@ DEFAULT_GRADATION = 1.3
 # unit per coordinate, so below this the mesh could not have the size asked for (and
 # at a few units, the points that split an edge would coincide).
 MIN_SIZE_ULPS = 64
+# How far (in its own edge lengths) a boundary edge's length holds as the size before
+# it grows at the gradation rate (see make_size_field).
+BOUNDARY_REACH = 10.0
 
 
 @dataclass(frozen=True)
@@ -234,17 +237,21 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
     if have_boundary:
         pts = np.asarray(boundary_points, dtype=np.float64)
         lengths = np.asarray(boundary_lengths, dtype=np.float64)
-        # each boundary vertex asks for its edge length, grown at the gradation rate
-        # out to the four grid nodes around it (not the bare length: a cell is much
-        # larger than a tiny edge, and bilinear interpolation would spread that tiny
-        # size over the whole cell)
+        # each boundary vertex asks for its edge length at the four grid nodes around
+        # it, as is out to BOUNDARY_REACH edge lengths away and growing at the
+        # gradation rate beyond (not the bare length at any distance: a cell can be
+        # far larger than a tiny edge, and bilinear interpolation would spread that
+        # tiny size over the whole cell; nor growing from the vertex itself: the
+        # field would then miss the boundary's sizes next to it, and on the graded
+        # naca0012 benchmark the mean radius ratio fell from 0.962 to 0.940)
         rate = spread - 1.0
         i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
         j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)
         for di in (0, 1):
             for dj in (0, 1):
                 dist = np.hypot(X[j + dj, i + di] - pts[:, 0], Y[j + dj, i + di] - pts[:, 1])
-                np.minimum.at(h, (j + dj, i + di), lengths + rate * dist)
+                np.minimum.at(h, (j + dj, i + di),
+                              lengths + rate * np.maximum(0.0, dist - BOUNDARY_REACH * lengths))
     h = limit_gradation(h, dx, dy, spread if not np.isfinite(h).all() else gradation)
     if not np.isfinite(h).all():
         raise InvalidSizeError("could not derive a size from the boundary")
