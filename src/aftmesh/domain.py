@@ -305,12 +305,12 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None)
     from ._kernel import py_orient2d
     if len(segs) == 0:
         return segs, src
+    segs = np.asarray(segs)
     lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
     # candidates: vertices within a tiny distance of a segment (shapely's own test may
     # miss a point that is exactly on the segment but not representable on its line)
     reach = max(tol, 1e-12 * float(np.abs(pts).max() + 1.0))
     vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
-    segs = np.asarray(segs)
     other = (vi != segs[si, 0]) & (vi != segs[si, 1])     # each segment finds its own ends
     vi, si = vi[other], si[other]
     cuts: dict[int, list[int]] = {}
@@ -321,8 +321,6 @@ def _split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None)
         fixed[segs[ring_source[np.asarray(src)]].ravel()] = True
     for v, k in zip(vi.tolist(), si.tolist()):
         a, b = segs[k]
-        if v == a or v == b:
-            continue
         pa, pb, pv = pts[a], pts[b], pts[v]
         if not (np.dot(pv - pa, pb - pa) > 0 and np.dot(pv - pb, pa - pb) > 0):
             continue
