@@ -117,7 +117,6 @@ def _keep_sides(points, split, vertices, segments, clear):
     the exact orientation predicate; the segment itself, unsplit, always qualifies)."""
     import shapely
     from ._kernel import py_orient2d
-    where = {int(k): i for i, k in enumerate(split)}
     a = vertices[segments[split, 0]]
     b = vertices[segments[split, 1]]
     lines = shapely.linestrings(np.stack([a, b], axis=1))
@@ -132,7 +131,7 @@ def _keep_sides(points, split, vertices, segments, clear):
         side = py_orient2d(a[i, 0], a[i, 1], b[i, 0], b[i, 1], pv[0], pv[1])
         if side == 0:
             continue        # on the segment: the CDT splits it there, as it would unsplit
-        pts = out[where[k]]
+        pts = out[i]            # lines[i] is segment split[i], whose points are points[i]
         changed = True
         while changed and len(pts):
             changed = False
@@ -148,7 +147,7 @@ def _keep_sides(points, split, vertices, segments, clear):
                     pts = np.delete(pts, drop, axis=0)
                     changed = True
                     break
-        out[where[k]] = pts
+        out[i] = pts
     return out
 
 
