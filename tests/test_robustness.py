@@ -542,14 +542,14 @@ def test_max_triangles_caps_the_mesh(case, cap, checked):
         assert mesh.n_triangles <= cap
 
 
-def test_max_triangles_caps_a_huge_request(checked):
+def test_max_triangles_caps_a_huge_request(checked, time_limit):
     """Size 1e-4 on the unit square asks for ~2e8 triangles; max_triangles=50000 must
     stop it early (the boundary alone needs 4e4)."""
     t = time.perf_counter()
     mesh = fd.isolated(aftmesh.generate, SQ, 1e-4, max_triangles=50000, timeout=GEN_TIMEOUT)
     checked(mesh, domain_area=1.0)
     assert mesh.n_triangles <= 50000
-    assert time.perf_counter() - t < 10
+    time_limit(time.perf_counter() - t, 10, "capped_s")
 
 
 def _big(progress=None, smooth=0):
@@ -557,7 +557,7 @@ def _big(progress=None, smooth=0):
     return aftmesh.generate(SQ, 0.0008, progress=progress, smooth=smooth)
 
 
-def test_ctrl_c_from_progress_callback(checked):
+def test_ctrl_c_from_progress_callback(checked, time_limit):
     """A progress callback raising KeyboardInterrupt stops the compiled loop at once;
     the next call works."""
     calls = []
@@ -573,10 +573,10 @@ def test_ctrl_c_from_progress_callback(checked):
     stopped = time.perf_counter()
     assert len(calls) == 3
     assert calls[-1][1] < 0.5, "the interrupt came late"
-    assert stopped - calls[-1][0] < 0.5, f"{stopped - calls[-1][0]:.2f} s after the callback raised"
+    time_limit(stopped - calls[-1][0], 0.5, "after_callback_raised_s")
     mesh = aftmesh.generate(SQ, 0.1)
     checked(mesh, domain_area=1.0)
-    assert stopped - t0 < 5
+    time_limit(stopped - t0, 5, "until_stopped_s")
 
 
 def test_progress_callback_other_errors_ignored(checked):
@@ -602,7 +602,7 @@ def _interrupt_after(delay: float, sig=signal.SIGINT):
     return th, record
 
 
-def test_sigint_during_large_mesh(checked, default_sigint):
+def test_sigint_during_large_mesh(checked, default_sigint, time_limit):
     """SIGINT (os.kill from a timer thread) while the compiled loop runs: the
     KeyboardInterrupt arrives within a fraction of a second and the process keeps
     working."""
@@ -623,14 +623,13 @@ def test_sigint_during_large_mesh(checked, default_sigint):
         got = time.perf_counter()
     assert got != "finished", "the large mesh finished before the signal: make it bigger"
     assert got is not None
-    latency = got - record["sent"]
-    assert latency < 0.5, f"KeyboardInterrupt {latency:.2f} s after SIGINT"
+    time_limit(got - record["sent"], 0.5, "interrupt_latency_s")
     mesh = aftmesh.generate(SQ, 0.1)
     checked(mesh, domain_area=1.0)
     assert same_arrays(mesh, aftmesh.generate(SQ, 0.1))
 
 
-def test_sigint_in_subprocess_exits_cleanly():
+def test_sigint_in_subprocess_exits_cleanly(time_limit):
     """The same from outside: SIGINT to a process in the middle of a large mesh gives
     a KeyboardInterrupt there (caught, then a small mesh is made), not a hang or a
     crash."""
@@ -664,7 +663,7 @@ def test_sigint_in_subprocess_exits_cleanly():
     assert proc.returncode == 0, err
     lines = out.split("\n")
     assert lines[0].startswith("interrupted"), out
-    assert float(lines[0].split()[1]) - sent < 1.0
+    time_limit(float(lines[0].split()[1]) - sent, 1.0, "interrupt_latency_s")
     assert lines[1].startswith("after") and int(lines[1].split()[1]) > 0
 
 

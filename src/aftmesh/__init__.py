@@ -9,8 +9,7 @@ from .generate import generate
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
                      InvalidOptionError, InvalidSizeError, KernelError)
 from .mesh import Mesh
+from ._version import __version__
 
-__version__ = "0.1.0"
-
-__all__ = ["cdt", "generate", "Mesh", "InvalidInputError", "InvalidDomainError",
+__all__ = ["__version__", "cdt", "generate", "Mesh", "InvalidInputError", "InvalidDomainError",
            "CrossingSegmentsError", "InvalidSizeError", "InvalidOptionError", "KernelError"]

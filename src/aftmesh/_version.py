@@ -1,0 +1,4 @@
+"""The package version, in one place: read by ``pyproject.toml`` at build time and
+re-exported as ``aftmesh.__version__``."""
+
+__version__ = "0.1.0"
