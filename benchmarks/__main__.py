@@ -83,7 +83,16 @@ def parse_args(argv):
 
 
 def main(argv=None) -> int:
-    args = parse_args(sys.argv[1:] if argv is None else argv)
+    from .runner import SetupError
+    try:
+        return _main(sys.argv[1:] if argv is None else argv)
+    except SetupError as exc:       # no aftmesh for the workers: say so once and stop
+        print(f"python -m benchmarks: {exc}", file=sys.stderr)
+        return 2
+
+
+def _main(argv) -> int:
+    args = parse_args(argv)
     if args.list:
         print("cases:  ", " ".join(_cases.case_names()))
         print("quick:  ", " ".join(_cases.QUICK_CASES))
@@ -103,6 +112,7 @@ def main(argv=None) -> int:
             results = {}
 
     if not args.report_only:
+        print(f"aftmesh: {runner.locate_aftmesh()}")
         results["meta"] = {"versions": _versions()}
         run_mesh = args.all or args.cases or not (args.scaling or args.cdt)
         t_all = time.perf_counter()

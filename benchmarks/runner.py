@@ -14,23 +14,70 @@ from .cases import build_case
 from .meshers import MESHERS, REFERENCE, mesher_available
 
 ROOT = Path(__file__).resolve().parent.parent
+SRC = ROOT / "src"
 MARK = "@@RESULT "
+HOW_TO_BUILD = ("Either install aftmesh (pip install .) or build its kernel in place in this "
+                "checkout (python setup.py build_ext --inplace); src/ is used only when the "
+                "kernel is built there.")
+# A kernel being rebuilt in place is briefly unimportable: one retry after this pause.
+REBUILD_PAUSE_S = 2.0
 
 
-def _env() -> dict:
+class SetupError(RuntimeError):
+    """The workers cannot import aftmesh: the run stops at once."""
+
+
+def kernel_in_place() -> bool:
+    """Whether ``src/aftmesh`` holds a compiled kernel (an in-place build)."""
+    pkg = SRC / "aftmesh"
+    return any(pkg.glob("_kernel*.so")) or any(pkg.glob("_kernel*.pyd"))
+
+
+_AFTMESH: dict = {}
+
+
+def _env_with(parts: list[str]) -> dict:
     env = dict(os.environ)
-    parts = [str(ROOT), str(ROOT / "src")]
     if env.get("PYTHONPATH"):
-        parts.append(env["PYTHONPATH"])
+        parts = parts + [env["PYTHONPATH"]]
     env["PYTHONPATH"] = os.pathsep.join(parts)
     env.setdefault("OMP_NUM_THREADS", "1")
     return env
 
 
+def locate_aftmesh() -> str:
+    """Decide once which aftmesh the workers import, check it in a worker-like process
+    and return its location: ``src/`` when the kernel is built in place there,
+    otherwise the installed package.  Raises `SetupError` saying how to fix it."""
+    if "file" not in _AFTMESH:
+        parts = [str(ROOT)] + ([str(SRC)] if kernel_in_place() else [])
+        code = "import aftmesh, aftmesh._kernel; print(aftmesh.__file__)"
+        try:
+            probe = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env_with(parts),
+                                   capture_output=True, text=True, timeout=120)
+        except subprocess.TimeoutExpired:
+            raise SetupError("importing aftmesh took over 120 s") from None
+        if probe.returncode != 0:
+            tail = (probe.stderr.strip().splitlines() or ["no output"])[-1]
+            where = "src/ (kernel built in place)" if len(parts) > 1 else "the installed packages"
+            raise SetupError(f"cannot import aftmesh from {where}: {tail}\n{HOW_TO_BUILD}")
+        _AFTMESH.update(parts=parts, file=probe.stdout.strip())
+    return _AFTMESH["file"]
+
+
+def _env() -> dict:
+    locate_aftmesh()
+    return _env_with(list(_AFTMESH["parts"]))
+
+
+def _import_failed(err: str) -> bool:
+    return err.startswith(("ImportError", "ModuleNotFoundError")) and "aftmesh" in err
+
+
 def run_job(job: dict, timeout: float) -> dict:
-    """Run one job in a fresh interpreter; a failure becomes ``{"error": ...}``.
-    A failed import of the compiled kernel (it may be being rebuilt) is retried."""
-    for attempt in range(3):
+    """Run one job in a fresh interpreter; a failure becomes ``{"error": ...}``, except
+    a worker that cannot import aftmesh, which stops the run (`SetupError`)."""
+    for attempt in range(2):
         t0 = time.perf_counter()
         try:
             proc = subprocess.run([sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
@@ -47,9 +94,12 @@ def run_job(job: dict, timeout: float) -> dict:
             res = {"error": f"worker exit {proc.returncode}: {tail}"}
         res["wall"] = wall
         err = res.get("error", "")
-        if "_kernel" in err and ("Import" in err or "undefined symbol" in err) and attempt < 2:
-            time.sleep(5)          # the kernel is being swapped: try again
+        if "_kernel" in err and ("Import" in err or "undefined symbol" in err) \
+                and kernel_in_place() and attempt == 0:
+            time.sleep(REBUILD_PAUSE_S)
             continue
+        if _import_failed(err):
+            raise SetupError(f"a worker cannot import aftmesh: {err}\n{HOW_TO_BUILD}")
         return res
     return res
 
