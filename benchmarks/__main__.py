@@ -1,4 +1,5 @@
 """``python -m benchmarks``: see benchmarks/README.md."""
+
 from __future__ import annotations
 
 import argparse
@@ -35,12 +36,17 @@ def _load() -> float | None:
 
 
 def _meta(quick: bool) -> dict:
-    return {"date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
-            "machine": _machine(), "quick": quick, "load_start": _load()}
+    return {
+        "date": datetime.datetime.now().strftime("%Y-%m-%d %H:%M"),
+        "machine": _machine(),
+        "quick": quick,
+        "load_start": _load(),
+    }
 
 
 def _versions() -> str:
     from importlib import metadata
+
     parts = [f"Python {platform.python_version()}"]
     for dist in ("aftmesh", "numpy", "triangle", "gmsh", "scipy"):
         try:
@@ -55,28 +61,46 @@ def _versions() -> str:
 
 
 def parse_args(argv):
-    p = argparse.ArgumentParser(prog="python -m benchmarks",
-                                description="aftmesh against Triangle and Gmsh.")
-    p.add_argument("--quick", action="store_true",
-                   help="fewer cases and repetitions (under a minute)")
-    p.add_argument("--cases", nargs="+", metavar="CASE",
-                   help="case names or fnmatch patterns (e.g. 'square-*'); any square-<h> or "
-                        "holes-<h> works")
-    p.add_argument("--meshers", nargs="+", metavar="MESHER", choices=list(MESHERS),
-                   help=f"subset of: {', '.join(MESHERS)}")
+    p = argparse.ArgumentParser(
+        prog="python -m benchmarks", description="aftmesh against Triangle and Gmsh."
+    )
+    p.add_argument(
+        "--quick", action="store_true", help="fewer cases and repetitions (under a minute)"
+    )
+    p.add_argument(
+        "--cases",
+        nargs="+",
+        metavar="CASE",
+        help="case names or fnmatch patterns (e.g. 'square-*'); any square-<h> or holes-<h> works",
+    )
+    p.add_argument(
+        "--meshers",
+        nargs="+",
+        metavar="MESHER",
+        choices=list(MESHERS),
+        help=f"subset of: {', '.join(MESHERS)}",
+    )
     p.add_argument("--repeat", type=int, default=5, help="timed runs per measurement (default 5)")
     p.add_argument("--scaling", action="store_true", help="run the scaling study")
     p.add_argument("--cdt", action="store_true", help="run the Delaunay/CDT comparison")
     p.add_argument("--all", action="store_true", help="meshing cases, --cdt and --scaling")
-    p.add_argument("--gmsh-limit", type=float, default=None,
-                   help="skip Gmsh on cases where aftmesh made more triangles than this "
-                        "(default 3e4 with --quick, 1e6 otherwise)")
-    p.add_argument("--update-readme", action="store_true",
-                   help="write the summary between <!-- bench:start --> and <!-- bench:end --> "
-                        "in README.md")
-    p.add_argument("--report-only", action="store_true",
-                   help="run nothing: rebuild results.md (and the README block) from "
-                        "out/results.json")
+    p.add_argument(
+        "--gmsh-limit",
+        type=float,
+        default=None,
+        help="skip Gmsh on cases where aftmesh made more triangles than this "
+        "(default 3e4 with --quick, 1e6 otherwise)",
+    )
+    p.add_argument(
+        "--update-readme",
+        action="store_true",
+        help="write the summary between <!-- bench:start --> and <!-- bench:end --> in README.md",
+    )
+    p.add_argument(
+        "--report-only",
+        action="store_true",
+        help="run nothing: rebuild results.md (and the README block) from out/results.json",
+    )
     p.add_argument("--list", action="store_true", help="list cases and meshers and exit")
     p.add_argument("--out", type=Path, default=OUT, help="output folder (default benchmarks/out)")
     return p.parse_args(argv)
@@ -84,9 +108,10 @@ def parse_args(argv):
 
 def main(argv=None) -> int:
     from .runner import SetupError
+
     try:
         return _main(sys.argv[1:] if argv is None else argv)
-    except SetupError as exc:       # no aftmesh for the workers: say so once and stop
+    except SetupError as exc:  # no aftmesh for the workers: say so once and stop
         print(f"python -m benchmarks: {exc}", file=sys.stderr)
         return 2
 
@@ -96,7 +121,7 @@ def _main(argv) -> int:
     if args.list:
         print("cases:  ", " ".join(_cases.case_names()))
         print("quick:  ", " ".join(_cases.QUICK_CASES))
-        for k, (label, desc) in MESHERS.items():
+        for k, (_label, desc) in MESHERS.items():
             print(f"mesher:  {k:14s} {desc}")
         return 0
     from . import plots, report, runner
@@ -122,8 +147,9 @@ def _main(argv) -> int:
             limit = args.gmsh_limit if args.gmsh_limit is not None else (3e4 if args.quick else 1e6)
             print(f"meshing: {len(names)} cases x {len(meshers)} meshers")
             meta = _meta(args.quick)
-            sec = runner.run_mesh_suite(names, meshers, quick=args.quick, repeat=args.repeat,
-                                        gmsh_limit=limit)
+            sec = runner.run_mesh_suite(
+                names, meshers, quick=args.quick, repeat=args.repeat, gmsh_limit=limit
+            )
             sec["meta"] = {**meta, "load_end": _load()}
             results["mesh"] = sec
         if args.cdt or args.all:
@@ -156,14 +182,17 @@ def _main(argv) -> int:
         print(f"(no figures: {exc})")
     print()
     print(text)
-    print(f"written: {out / 'results.md'}, {out / 'results.json'}"
-          + (f", {len(pngs)} PNGs" if pngs else ""))
+    print(
+        f"written: {out / 'results.md'}, {out / 'results.json'}"
+        + (f", {len(pngs)} PNGs" if pngs else "")
+    )
     if args.update_readme:
         if report.update_readme(README, report.summary(results)):
             print(f"updated the benchmark block of {README}")
         else:
-            print(f"{README} has no '{report.START}' ... '{report.END}' block: "
-                  "README left unchanged")
+            print(
+                f"{README} has no '{report.START}' ... '{report.END}' block: README left unchanged"
+            )
     return 0
 
 

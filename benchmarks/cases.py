@@ -6,12 +6,13 @@ integrating 1/size along the curve for the graded airfoil), never by the meshers
 aftmesh runs with ``split_boundary=False``, Triangle may be told ``Y`` and Gmsh gets one
 geometric line per segment with exactly two mesh nodes.
 """
+
 from __future__ import annotations
 
 import fnmatch
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -24,13 +25,13 @@ class Case:
 
     name: str
     description: str
-    vertices: np.ndarray              # (n, 2) float64
-    segments: np.ndarray              # (m, 2) int32
-    holes: np.ndarray                 # (k, 2) float64 points inside holes
-    h: float                          # uniform target edge length (or the smallest one)
-    size: Callable | None = None      # graded size f(x, y) -> array; None: uniform h
-    gmsh_size_expr: str | None = None # the same graded size as a Gmsh MathEval formula
-    regions: np.ndarray | None = None # (r, 3) x, y, marker
+    vertices: np.ndarray  # (n, 2) float64
+    segments: np.ndarray  # (m, 2) int32
+    holes: np.ndarray  # (k, 2) float64 points inside holes
+    h: float  # uniform target edge length (or the smallest one)
+    size: Callable | None = None  # graded size f(x, y) -> array; None: uniform h
+    gmsh_size_expr: str | None = None  # the same graded size as a Gmsh MathEval formula
+    regions: np.ndarray | None = None  # (r, 3) x, y, marker
     notes: list[str] = field(default_factory=list)
 
     @property
@@ -51,13 +52,14 @@ class Case:
             d["holes"] = self.holes
         if self.regions is not None and len(self.regions):
             reg = self.regions
-            if with_region_areas:   # Triangle wants (x, y, attribute, max_area)
+            if with_region_areas:  # Triangle wants (x, y, attribute, max_area)
                 reg = np.column_stack([reg, np.zeros(len(reg))])
             d["regions"] = reg
         return d
 
 
 # --------------------------------------------------------------------------- helpers
+
 
 def _ring(points: np.ndarray, offset: int) -> np.ndarray:
     n = len(points)
@@ -107,15 +109,20 @@ def _circle(cx: float, cy: float, r: float, h: float) -> np.ndarray:
 
 # --------------------------------------------------------------------------- cases
 
+
 def square(h: float) -> Case:
     corners = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     v = _split_polyline_uniform(corners, h)
-    return Case(f"square-{h:g}", f"unit square, h = {h:g}", v, _ring(v, 0),
-                np.zeros((0, 2)), h)
+    return Case(f"square-{h:g}", f"unit square, h = {h:g}", v, _ring(v, 0), np.zeros((0, 2)), h)
 
 
-HOLES = [(0.25, 0.25, 0.10), (0.75, 0.25, 0.12), (0.50, 0.55, 0.15),
-         (0.22, 0.80, 0.08), (0.78, 0.78, 0.10)]
+HOLES = [
+    (0.25, 0.25, 0.10),
+    (0.75, 0.25, 0.12),
+    (0.50, 0.55, 0.15),
+    (0.22, 0.80, 0.08),
+    (0.78, 0.78, 0.10),
+]
 
 
 def holes(h: float) -> Case:
@@ -127,16 +134,22 @@ def holes(h: float) -> Case:
         v.append(ring)
         s.append(_ring(ring, off))
         off += len(ring)
-    return Case(f"holes-{h:g}", f"unit square with {len(HOLES)} circular holes, h = {h:g}",
-                np.concatenate(v), np.concatenate(s),
-                np.array([[cx, cy] for cx, cy, _ in HOLES]), h)
+    return Case(
+        f"holes-{h:g}",
+        f"unit square with {len(HOLES)} circular holes, h = {h:g}",
+        np.concatenate(v),
+        np.concatenate(s),
+        np.array([[cx, cy] for cx, cy, _ in HOLES]),
+        h,
+    )
 
 
 def naca_thickness(x: np.ndarray, t: float = 0.12) -> np.ndarray:
     """Half thickness of a symmetric 4-digit NACA section, closed trailing edge
     (last coefficient -0.1036 instead of -0.1015)."""
-    return 5.0 * t * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x ** 2
-                      + 0.2843 * x ** 3 - 0.1036 * x ** 4)
+    return (
+        5.0 * t * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
+    )
 
 
 # size around the airfoil: H0 on the chord, growing by SLOPE per unit distance, at most HMAX
@@ -154,12 +167,12 @@ def naca_size(x, y):
 
 def naca0012() -> Case:
     beta = np.linspace(0.0, math.pi, 20001)
-    xs = 0.5 * (1.0 - np.cos(beta))                   # dense near both ends
-    upper = np.column_stack([xs[::-1], naca_thickness(xs[::-1])])   # TE -> LE
-    up = _split_graded(upper, naca_size)              # TE ... LE
-    low = up[::-1].copy()                             # LE ... TE, mirrored
+    xs = 0.5 * (1.0 - np.cos(beta))  # dense near both ends
+    upper = np.column_stack([xs[::-1], naca_thickness(xs[::-1])])  # TE -> LE
+    up = _split_graded(upper, naca_size)  # TE ... LE
+    low = up[::-1].copy()  # LE ... TE, mirrored
     low[:, 1] *= -1.0
-    foil = np.concatenate([up[:-1], low[:-1]])        # clockwise ring (a hole boundary)
+    foil = np.concatenate([up[:-1], low[:-1]])  # clockwise ring (a hole boundary)
     x0, y0, x1, y1 = NACA_BOX
     box_pts = []
     corners = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]])
@@ -172,10 +185,17 @@ def naca0012() -> Case:
     s = np.concatenate([_ring(box, 0), _ring(foil, len(box))])
     dxe = "Max(Max(-x, x - 1), 0)"
     expr = f"Min({NACA_H0} + {NACA_SLOPE} * Sqrt({dxe} * {dxe} + y * y), {NACA_HMAX})"
-    return Case("naca0012",
-                f"NACA 0012 in a {x1 - x0:g} x {y1 - y0:g} box, size {NACA_H0:g} + "
-                f"{NACA_SLOPE:g} * dist(chord), at most {NACA_HMAX:g}",
-                v, s, np.array([[0.5, 0.0]]), NACA_H0, size=naca_size, gmsh_size_expr=expr)
+    return Case(
+        "naca0012",
+        f"NACA 0012 in a {x1 - x0:g} x {y1 - y0:g} box, size {NACA_H0:g} + "
+        f"{NACA_SLOPE:g} * dist(chord), at most {NACA_HMAX:g}",
+        v,
+        s,
+        np.array([[0.5, 0.0]]),
+        NACA_H0,
+        size=naca_size,
+        gmsh_size_expr=expr,
+    )
 
 
 def comb(h: float = 0.01, teeth: int = 13, slit: float = 0.003) -> Case:
@@ -191,8 +211,14 @@ def comb(h: float = 0.01, teeth: int = 13, slit: float = 0.003) -> Case:
         x -= slit
     corners += [[0.0, 0.5]]
     v = _split_polyline_uniform(np.array(corners), h)
-    return Case("comb", f"comb: 1 x 0.5 plate, {n_slits} slits {slit:g} wide, h = {h:g}",
-                v, _ring(v, 0), np.zeros((0, 2)), h)
+    return Case(
+        "comb",
+        f"comb: 1 x 0.5 plate, {n_slits} slits {slit:g} wide, h = {h:g}",
+        v,
+        _ring(v, 0),
+        np.zeros((0, 2)),
+        h,
+    )
 
 
 def inclusion(h: float = 0.01) -> Case:
@@ -200,18 +226,25 @@ def inclusion(h: float = 0.01) -> Case:
     inner = _split_polyline_uniform(np.array([[0.3, 0.3], [0.7, 0.3], [0.7, 0.7], [0.3, 0.7]]), h)
     v = np.concatenate([outer, inner])
     s = np.concatenate([_ring(outer, 0), _ring(inner, len(outer))])
-    return Case("inclusion", f"unit square with a 0.4 x 0.4 inclusion (2 regions), h = {h:g}",
-                v, s, np.zeros((0, 2)), h,
-                regions=np.array([[0.1, 0.1, 1.0], [0.5, 0.5, 2.0]]))
+    return Case(
+        "inclusion",
+        f"unit square with a 0.4 x 0.4 inclusion (2 regions), h = {h:g}",
+        v,
+        s,
+        np.zeros((0, 2)),
+        h,
+        regions=np.array([[0.1, 0.1, 1.0], [0.5, 0.5, 2.0]]),
+    )
 
 
 POLY_FILES = ("A", "face", "la", "double_hex3")
-POLY_DIVISIONS = 150      # h = bounding-box diagonal / POLY_DIVISIONS
+POLY_DIVISIONS = 150  # h = bounding-box diagonal / POLY_DIVISIONS
 
 
 def poly(name: str) -> Case:
     """One of Triangle's sample .poly files; every segment cut into pieces <= h."""
     import triangle
+
     d = triangle.get_data(name)
     v0 = np.asarray(d["vertices"], dtype=float)
     s0 = np.asarray(d["segments"], dtype=np.int64).reshape(-1, 2)
@@ -240,10 +273,16 @@ def poly(name: str) -> Case:
     n_free = int((np.bincount(s0.ravel(), minlength=len(v0)) == 0).sum())
     if n_free:
         notes.append(f"{n_free} free input vertices")
-    return Case(f"poly-{name}",
-                f"Triangle sample {name}.poly, h = bbox diagonal / {POLY_DIVISIONS} = {h:.4g}",
-                np.concatenate(verts), np.asarray(segs, dtype=np.int32), holes_, h,
-                regions=regions, notes=notes)
+    return Case(
+        f"poly-{name}",
+        f"Triangle sample {name}.poly, h = bbox diagonal / {POLY_DIVISIONS} = {h:.4g}",
+        np.concatenate(verts),
+        np.asarray(segs, dtype=np.int32),
+        holes_,
+        h,
+        regions=regions,
+        notes=notes,
+    )
 
 
 # --------------------------------------------------------------------------- registry
@@ -251,11 +290,23 @@ def poly(name: str) -> Case:
 SQUARE_H = (0.02, 0.01, 0.005, 0.0025, 0.001)
 HOLES_H = (0.01, 0.005)
 
-ALL_CASES = ([f"square-{h:g}" for h in SQUARE_H] + [f"holes-{h:g}" for h in HOLES_H]
-             + ["naca0012"] + [f"poly-{p}" for p in POLY_FILES] + ["comb", "inclusion"])
+ALL_CASES = (
+    [f"square-{h:g}" for h in SQUARE_H]
+    + [f"holes-{h:g}" for h in HOLES_H]
+    + ["naca0012"]
+    + [f"poly-{p}" for p in POLY_FILES]
+    + ["comb", "inclusion"]
+)
 
-QUICK_CASES = ["square-0.01", "square-0.005", "naca0012", "poly-A", "poly-face", "comb",
-               "inclusion"]
+QUICK_CASES = [
+    "square-0.01",
+    "square-0.005",
+    "naca0012",
+    "poly-A",
+    "poly-face",
+    "comb",
+    "inclusion",
+]
 
 
 def case_names() -> list[str]:
@@ -289,6 +340,6 @@ def select_cases(patterns: list[str] | None, quick: bool) -> list[str]:
     for pat in patterns:
         hits = [c for c in ALL_CASES if fnmatch.fnmatch(c, pat)]
         if not hits:
-            hits = [pat]           # e.g. square-0.0007: built on demand
+            hits = [pat]  # e.g. square-0.0007: built on demand
         out += [c for c in hits if c not in out]
     return out

@@ -1,4 +1,5 @@
 """Memory and quality measurements, the same code for every mesher."""
+
 from __future__ import annotations
 
 import gc

@@ -4,18 +4,28 @@
 formatting Triangle's switches) and returns a :class:`Runner`; ``runner.run()`` is the
 timed call; ``runner.result(raw)`` turns what it returned into plain arrays.
 """
+
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from .cases import Case
 
-__all__ = ["MESHERS", "DEFAULT_MESHERS", "REFERENCE", "Runner", "MeshOut", "prepare",
-           "mesher_available", "triangle_area_switch"]
+__all__ = [
+    "MESHERS",
+    "DEFAULT_MESHERS",
+    "REFERENCE",
+    "Runner",
+    "MeshOut",
+    "prepare",
+    "mesher_available",
+    "triangle_area_switch",
+]
 
 REFERENCE = "tri-pq30"
 
@@ -24,16 +34,16 @@ REFERENCE = "tri-pq30"
 class MeshOut:
     points: np.ndarray
     triangles: np.ndarray
-    n_segments: int          # constrained edges in the output (input ones and pieces)
+    n_segments: int  # constrained edges in the output (input ones and pieces)
 
 
 @dataclass
 class Runner:
     run: Callable[[], Any]
     result: Callable[[Any], MeshOut]
-    reset: Callable[[], None] = lambda: None      # untimed, between repetitions
+    reset: Callable[[], None] = lambda: None  # untimed, between repetitions
     close: Callable[[], None] = lambda: None
-    passes: int | None = None                       # Triangle refinement passes (graded)
+    passes: int | None = None  # Triangle refinement passes (graded)
 
 
 # name -> (label for the tables, short description)
@@ -59,7 +69,7 @@ def mesher_available(name: str) -> str | None:
             import gmsh  # noqa: F401
         else:
             import aftmesh  # noqa: F401
-    except Exception as exc:            # an optional dependency is missing
+    except Exception as exc:  # an optional dependency is missing
         return f"{type(exc).__name__}: {exc}"
     return None
 
@@ -73,8 +83,10 @@ def triangle_area_switch(area: float) -> str:
 
 # ----------------------------------------------------------------------- aftmesh
 
+
 def _aft(case: Case, greedy: bool) -> Runner:
     import aftmesh
+
     dom = case.as_triangle_dict()
     size = case.size_arg
 
@@ -89,22 +101,25 @@ def _aft(case: Case, greedy: bool) -> Runner:
 
 # ----------------------------------------------------------------------- Triangle
 
+
 def _triangle(case: Case, switches: str) -> Runner:
     import triangle
+
     regions = case.regions is not None and len(case.regions) > 0
     dom = case.as_triangle_dict(with_region_areas=True)
     extra = "A" if regions else ""
     quality = "q" in switches
 
     def result(r):
-        return MeshOut(np.asarray(r["vertices"]), np.asarray(r["triangles"]),
-                       len(r.get("segments", ())))
+        return MeshOut(
+            np.asarray(r["vertices"]), np.asarray(r["triangles"]), len(r.get("segments", ()))
+        )
 
     if not quality:
         return Runner(lambda: triangle.triangulate(dom, switches + extra), result)
 
     if case.size is None:
-        area = math.sqrt(3) / 4 * case.h ** 2
+        area = math.sqrt(3) / 4 * case.h**2
         opts = switches + triangle_area_switch(area) + extra
         return Runner(lambda: triangle.triangulate(dom, opts), result)
 
@@ -126,8 +141,12 @@ def _triangle(case: Case, switches: str) -> Runner:
             area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
             if (area <= 1.02 * target).all():
                 break
-            inp = {"vertices": r["vertices"], "triangles": r["triangles"],
-                   "segments": r["segments"], "triangle_max_area": target}
+            inp = {
+                "vertices": r["vertices"],
+                "triangles": r["triangles"],
+                "segments": r["segments"],
+                "triangle_max_area": target,
+            }
             if "triangle_attributes" in r:
                 inp["triangle_attributes"] = r["triangle_attributes"]
             r = triangle.triangulate(inp, "r" + switches + "a" + extra)
@@ -140,6 +159,7 @@ def _triangle(case: Case, switches: str) -> Runner:
 
 
 # ----------------------------------------------------------------------- Gmsh
+
 
 def _faces(case: Case):
     """The bounded faces of the segment graph that are not holes, each as
@@ -166,8 +186,9 @@ def _faces(case: Case):
     for _, outer, inners in faces:
         for ring in [outer, *inners]:
             n = len(ring)
-            used.update((min(ring[k], ring[(k + 1) % n]), max(ring[k], ring[(k + 1) % n]))
-                        for k in range(n))
+            used.update(
+                (min(ring[k], ring[(k + 1) % n]), max(ring[k], ring[(k + 1) % n])) for k in range(n)
+            )
     loose_segments = [k for k, (a, b) in enumerate(S) if (min(a, b), max(a, b)) not in used]
     on_segment = np.zeros(len(V), dtype=bool)
     on_segment[S.ravel()] = True
@@ -202,7 +223,7 @@ def _gmsh(case: Case, algorithm: int) -> Runner:
         geo.addPoint(float(x), float(y), 0.0, lc, i + 1)
     for k, (a, b) in enumerate(S):
         geo.addLine(int(a) + 1, int(b) + 1, k + 1)
-        geo.mesh.setTransfiniteCurve(k + 1, 2)      # exactly the given segment
+        geo.mesh.setTransfiniteCurve(k + 1, 2)  # exactly the given segment
 
     seg_of = {}
     for k, (a, b) in enumerate(S):
@@ -251,8 +272,10 @@ def _gmsh(case: Case, algorithm: int) -> Runner:
             n_lines = len(gmsh.model.mesh.getElementsByType(1)[0])
         # gmsh's triangles may be clockwise: orient them counter-clockwise
         p = pts[tris]
-        cw = ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-              - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])) < 0
+        cw = (
+            (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+            - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+        ) < 0
         tris[cw] = tris[cw][:, ::-1]
         return MeshOut(pts, tris, n_lines)
 

@@ -1,4 +1,5 @@
 """PNG figures: radius-ratio histograms and the scaling plot."""
+
 from __future__ import annotations
 
 from pathlib import Path
@@ -11,8 +12,10 @@ from .meshers import MESHERS
 
 def _plt():
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     return plt
 
 
@@ -22,8 +25,7 @@ def _hist_axes(ax, rows, title):
         counts = np.asarray(r["stats"]["rr_hist"], dtype=float)
         if counts.sum() == 0:
             continue
-        ax.stairs(counts / counts.sum(), edges,
-                  label=MESHERS.get(r["mesher"], (r["mesher"],))[0])
+        ax.stairs(counts / counts.sum(), edges, label=MESHERS.get(r["mesher"], (r["mesher"],))[0])
     ax.set_yscale("log")
     ax.set_xlabel("radius ratio 2 r_in / r_circ")
     ax.set_ylabel("fraction of triangles")
@@ -37,8 +39,11 @@ def mesh_histograms(mesh: dict, out: Path) -> list[Path]:
     for stale in out.glob("hist_*.png"):
         stale.unlink()
     for cname in dict.fromkeys(r["case"] for r in mesh["rows"]):
-        rows = [r for r in mesh["rows"] if r["case"] == cname and "stats" in r
-                and r["mesher"] not in ("aft-greedy", "tri-p")]
+        rows = [
+            r
+            for r in mesh["rows"]
+            if r["case"] == cname and "stats" in r and r["mesher"] not in ("aft-greedy", "tri-p")
+        ]
         if not rows:
             continue
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -62,11 +67,15 @@ def scaling_plots(sc: dict, out: Path) -> list[Path]:
         n = np.array([r["triangles"] for r in ok], dtype=float)
         t = np.array([r["median"] for r in ok])
         label = MESHERS.get(mname, (mname,))[0]
-        line, = ax.loglog(n, t, "o-", label=f"{label} (slope {fit['all']:.2f})"
-                          if fit["all"] is not None else label)
+        (line,) = ax.loglog(
+            n,
+            t,
+            "o-",
+            label=f"{label} (slope {fit['all']:.2f})" if fit["all"] is not None else label,
+        )
         if len(n) >= 2:
             k, c = np.polyfit(np.log(n), np.log(t), 1)
-            ax.loglog(n, np.exp(c) * n ** k, "--", color=line.get_color(), lw=0.8)
+            ax.loglog(n, np.exp(c) * n**k, "--", color=line.get_color(), lw=0.8)
     ax.set_xlabel("triangles")
     ax.set_ylabel("wall time (s), median")
     ax.set_title("unit square, uniform size")

@@ -1,5 +1,6 @@
 """Run the measurements: one subprocess per (mesher, case), per CDT memory probe and
 one for the CDT speed comparison; collect what they print."""
+
 from __future__ import annotations
 
 import json
@@ -16,9 +17,11 @@ from .meshers import MESHERS, REFERENCE, mesher_available
 ROOT = Path(__file__).resolve().parent.parent
 SRC = ROOT / "src"
 MARK = "@@RESULT "
-HOW_TO_BUILD = ("Either install aftmesh (pip install .) or build its kernel in place in this "
-                "checkout (python setup.py build_ext --inplace); src/ is used only when the "
-                "kernel is built there.")
+HOW_TO_BUILD = (
+    "Either install aftmesh (pip install .) or build its kernel in place in this "
+    "checkout (python setup.py build_ext --inplace); src/ is used only when the "
+    "kernel is built there."
+)
 # A kernel being rebuilt in place is briefly unimportable: one retry after this pause.
 REBUILD_PAUSE_S = 2.0
 
@@ -53,8 +56,14 @@ def locate_aftmesh() -> str:
         parts = [str(ROOT)] + ([str(SRC)] if kernel_in_place() else [])
         code = "import aftmesh, aftmesh._kernel; print(aftmesh.__file__)"
         try:
-            probe = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env_with(parts),
-                                   capture_output=True, text=True, timeout=120)
+            probe = subprocess.run(
+                [sys.executable, "-c", code],
+                cwd=ROOT,
+                env=_env_with(parts),
+                capture_output=True,
+                text=True,
+                timeout=120,
+            )
         except subprocess.TimeoutExpired:
             raise SetupError("importing aftmesh took over 120 s") from None
         if probe.returncode != 0:
@@ -80,22 +89,31 @@ def run_job(job: dict, timeout: float) -> dict:
     for attempt in range(2):
         t0 = time.perf_counter()
         try:
-            proc = subprocess.run([sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
-                                  cwd=ROOT, env=_env(), capture_output=True, text=True,
-                                  timeout=timeout)
+            proc = subprocess.run(
+                [sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
+                cwd=ROOT,
+                env=_env(),
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+            )
         except subprocess.TimeoutExpired:
             return {"error": f"timeout after {timeout:.0f} s"}
         wall = time.perf_counter() - t0
         lines = [ln for ln in proc.stdout.splitlines() if ln.startswith(MARK)]
         if lines:
-            res = json.loads(lines[-1][len(MARK):])
+            res = json.loads(lines[-1][len(MARK) :])
         else:
             tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
             res = {"error": f"worker exit {proc.returncode}: {tail}"}
         res["wall"] = wall
         err = res.get("error", "")
-        if "_kernel" in err and ("Import" in err or "undefined symbol" in err) \
-                and kernel_in_place() and attempt == 0:
+        if (
+            "_kernel" in err
+            and ("Import" in err or "undefined symbol" in err)
+            and kernel_in_place()
+            and attempt == 0
+        ):
             time.sleep(REBUILD_PAUSE_S)
             continue
         if _import_failed(err):
@@ -110,18 +128,21 @@ def _median(xs):
 
 # ----------------------------------------------------------------------- meshing
 
+
 def reference_area(case) -> float | None:
     """Area of the faces that are not holes (what every mesher should cover)."""
     try:
         from .meshers import _faces
+
         faces, _, _ = _faces(case)
         return float(sum(poly.area for poly, _, _ in faces))
     except Exception:
         return None
 
 
-def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
-                   gmsh_limit: float, log=print) -> dict:
+def run_mesh_suite(
+    case_names, mesher_names, *, quick: bool, repeat: int, gmsh_limit: float, log=print
+) -> dict:
     rows = []
     cases_meta = {}
     for cname in case_names:
@@ -131,9 +152,14 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
             log(f"  {cname}: cannot build: {exc}")
             rows.append({"case": cname, "mesher": "-", "error": f"case: {exc}"})
             continue
-        cases_meta[cname] = {"description": case.description, "vertices": len(case.vertices),
-                             "segments": len(case.segments), "holes": len(case.holes),
-                             "notes": case.notes, "area": reference_area(case)}
+        cases_meta[cname] = {
+            "description": case.description,
+            "vertices": len(case.vertices),
+            "segments": len(case.segments),
+            "holes": len(case.holes),
+            "notes": case.notes,
+            "area": reference_area(case),
+        }
         aft_triangles = None
         for mname in mesher_names:
             row = {"case": cname, "mesher": mname}
@@ -142,16 +168,27 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
                 row["error"] = f"not available ({why})"
                 rows.append(row)
                 continue
-            if (mname.startswith("gmsh") and aft_triangles is not None
-                    and aft_triangles > gmsh_limit):
-                row["skipped"] = (f"skipped: about {aft_triangles:.2g} triangles > gmsh limit "
-                                  f"{gmsh_limit:.2g} (--gmsh-limit)")
+            if (
+                mname.startswith("gmsh")
+                and aft_triangles is not None
+                and aft_triangles > gmsh_limit
+            ):
+                row["skipped"] = (
+                    f"skipped: about {aft_triangles:.2g} triangles > gmsh limit "
+                    f"{gmsh_limit:.2g} (--gmsh-limit)"
+                )
                 rows.append(row)
                 log(f"  {cname:18s} {mname:14s} {row['skipped']}")
                 continue
-            job = {"kind": "mesh", "case": cname, "mesher": mname, "repeat": repeat,
-                   "min_repeat": 1 if quick else min(repeat, 5), "budget": 0.25 if quick else 60.0,
-                   "edges": True}
+            job = {
+                "kind": "mesh",
+                "case": cname,
+                "mesher": mname,
+                "repeat": repeat,
+                "min_repeat": 1 if quick else min(repeat, 5),
+                "budget": 0.25 if quick else 60.0,
+                "edges": True,
+            }
             res = run_job(job, timeout=120 if quick else 1200)
             row.update(res)
             if "times" in res:
@@ -160,13 +197,21 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
                 row["triangles"] = res["stats"]["triangles"]
                 if mname == "aft":
                     aft_triangles = row["triangles"]
-                log(f"  {cname:18s} {mname:14s} {row['triangles']:>9d} tri  "
-                    f"{row['median']:.4f} s  ({len(res['times'])} runs)")
+                log(
+                    f"  {cname:18s} {mname:14s} {row['triangles']:>9d} tri  "
+                    f"{row['median']:.4f} s  ({len(res['times'])} runs)"
+                )
             else:
                 log(f"  {cname:18s} {mname:14s} ERROR {res.get('error')}")
             rows.append(row)
-        ref = next((r for r in rows if r["case"] == cname and r["mesher"] == REFERENCE
-                    and r.get("median")), None)
+        ref = next(
+            (
+                r
+                for r in rows
+                if r["case"] == cname and r["mesher"] == REFERENCE and r.get("median")
+            ),
+            None,
+        )
         mine = [r for r in rows if r["case"] == cname and r.get("median")]
         for r in mine:
             r["tri_per_s"] = r["triangles"] / r["median"]
@@ -175,18 +220,28 @@ def run_mesh_suite(case_names, mesher_names, *, quick: bool, repeat: int,
                 r["time_ratio"] = r["median"] / ref["median"]
                 r["rate_ratio"] = r["tri_per_s"] / ref["tri_per_s"]
                 r["cpu_ratio"] = r["cpu_median"] / ref["cpu_median"]
-    return {"rows": rows, "cases": cases_meta, "meshers": {m: MESHERS[m] for m in mesher_names},
-            "reference": REFERENCE}
+    return {
+        "rows": rows,
+        "cases": cases_meta,
+        "meshers": {m: MESHERS[m] for m in mesher_names},
+        "reference": REFERENCE,
+    }
 
 
 # ----------------------------------------------------------------------- CDT
 
+
 def run_cdt_suite(*, quick: bool, repeat: int, log=print) -> dict:
     tools = ["aft", "tri", "scipy"]
     sizes = [1e4, 1e5, 1e6]
-    job = {"kind": "cdt-speed", "sizes": sizes, "repeat": repeat,
-           "repeat_big": 1 if quick else max(3, min(repeat, 5)),
-           "constrained": True, "tools": tools}
+    job = {
+        "kind": "cdt-speed",
+        "sizes": sizes,
+        "repeat": repeat,
+        "repeat_big": 1 if quick else max(3, min(repeat, 5)),
+        "constrained": True,
+        "tools": tools,
+    }
     log("  CDT speed (one process) ...")
     res = run_job(job, timeout=300 if quick else 1800)
     rows = res.get("rows", [])
@@ -197,8 +252,14 @@ def run_cdt_suite(*, quick: bool, repeat: int, log=print) -> dict:
             r["median"] = _median(r["times"])
             r["cpu_median"] = _median(r["cpu"])
     for r in rows:
-        ref = next((x for x in rows if x["input"] == r["input"] and x["tool"] == "tri"
-                    and x.get("median")), None)
+        ref = next(
+            (
+                x
+                for x in rows
+                if x["input"] == r["input"] and x["tool"] == "tri" and x.get("median")
+            ),
+            None,
+        )
         if r.get("median") and ref:
             r["time_ratio"] = r["median"] / ref["median"]
             r["cpu_ratio"] = r["cpu_median"] / ref["cpu_median"]
@@ -223,6 +284,7 @@ SCALING_MESHERS = ["aft", REFERENCE]
 def fit_exponent(n, t):
     """Least-squares slope of log t against log n."""
     import numpy as np
+
     n = np.log(np.asarray(n, dtype=float))
     t = np.log(np.asarray(t, dtype=float))
     if len(n) < 2:
@@ -235,17 +297,25 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
     rows = []
     for h in hs:
         for mname in SCALING_MESHERS:
-            job = {"kind": "mesh", "case": f"square-{h:g}", "mesher": mname,
-                   "repeat": repeat if h > 0.002 else 3, "min_repeat": 1,
-                   "budget": 1.0 if quick else 20.0, "edges": False}
+            job = {
+                "kind": "mesh",
+                "case": f"square-{h:g}",
+                "mesher": mname,
+                "repeat": repeat if h > 0.002 else 3,
+                "min_repeat": 1,
+                "budget": 1.0 if quick else 20.0,
+                "edges": False,
+            }
             res = run_job(job, timeout=300 if quick else 1800)
             row = {"h": h, "mesher": mname, **res}
             if "times" in res:
                 row["median"] = _median(res["times"])
                 row["cpu_median"] = _median(res["cpu"])
                 row["triangles"] = res["stats"]["triangles"]
-                log(f"  h={h:<8g} {mname:10s} {row['triangles']:>9d} tri  {row['median']:.4f} s"
-                    f"  {res['mem_mib']:.0f} MiB")
+                log(
+                    f"  h={h:<8g} {mname:10s} {row['triangles']:>9d} tri  {row['median']:.4f} s"
+                    f"  {res['mem_mib']:.0f} MiB"
+                )
             else:
                 log(f"  h={h:<8g} {mname:10s} ERROR {res.get('error')}")
             rows.append(row)
@@ -257,7 +327,8 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
             "all": fit_exponent([r["triangles"] for r in ok], [r["median"] for r in ok]),
             "from_1e5": fit_exponent([r["triangles"] for r in big], [r["median"] for r in big]),
             "cpu_all": fit_exponent([r["triangles"] for r in ok], [r["cpu_median"] for r in ok]),
-            "cpu_from_1e5": fit_exponent([r["triangles"] for r in big],
-                                         [r["cpu_median"] for r in big]),
+            "cpu_from_1e5": fit_exponent(
+                [r["triangles"] for r in big], [r["cpu_median"] for r in big]
+            ),
         }
     return {"rows": rows, "fits": fits}

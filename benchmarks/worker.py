@@ -6,6 +6,7 @@ Prints one line ``@@RESULT <json>`` at the end.  Jobs:
 * ``{"kind": "cdt-speed", "sizes", "repeat", "constrained", "tools"}``
 * ``{"kind": "cdt-mem", "tool", "n"}``
 """
+
 from __future__ import annotations
 
 import gc
@@ -25,6 +26,7 @@ def _emit(obj) -> None:
 
 
 # ----------------------------------------------------------------------- meshing
+
 
 def mesh_job(job: dict) -> dict:
     from .cases import build_case, square
@@ -72,8 +74,15 @@ def mesh_job(job: dict) -> dict:
     internal = None
     if all(timings):
         internal = {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
-    return {"times": times, "cpu": cpu, "mem_mib": mem, "mem_method": probe.method, "stats": stats,
-            "passes": passes, "internal_timing": internal}
+    return {
+        "times": times,
+        "cpu": cpu,
+        "mem_mib": mem,
+        "mem_method": probe.method,
+        "stats": stats,
+        "passes": passes,
+        "internal_timing": internal,
+    }
 
 
 def _internal_timing(raw):
@@ -88,6 +97,7 @@ def _internal_timing(raw):
 
 
 # ----------------------------------------------------------------------- CDT
+
 
 def random_points(n: int, seed: int = 12345) -> np.ndarray:
     return np.random.default_rng(seed).random((n, 2))
@@ -124,11 +134,13 @@ def _cdt_call(tool: str, pts, segs=None):
     """A callable doing one triangulation and returning its triangle count."""
     if tool == "aft":
         import aftmesh
+
         if segs is None:
             return lambda: aftmesh.cdt(pts).n_triangles
         return lambda: aftmesh.cdt(pts, segs).n_triangles
     if tool == "tri":
         import triangle
+
         if segs is None:
             d = {"vertices": pts}
             return lambda: len(triangle.triangulate(d, "")["triangles"])
@@ -136,7 +148,8 @@ def _cdt_call(tool: str, pts, segs=None):
         return lambda: len(triangle.triangulate(d, "p")["triangles"])
     if tool == "scipy":
         from scipy.spatial import Delaunay
-        return lambda: len(Delaunay(pts).simplices)   # unconstrained, even with segments
+
+        return lambda: len(Delaunay(pts).simplices)  # unconstrained, even with segments
     raise KeyError(tool)
 
 
@@ -161,8 +174,12 @@ def cdt_speed_job(job: dict) -> dict:
         inputs.append((f"{_count(len(p))} grid points + {_count(len(s) - 4)} segments", p, s))
     for label, pts, segs in inputs:
         for tool in tools:
-            row = {"input": label, "tool": tool, "n_points": int(len(pts)),
-                   "n_segments": 0 if segs is None else int(len(segs))}
+            row = {
+                "input": label,
+                "tool": tool,
+                "n_points": int(len(pts)),
+                "n_segments": 0 if segs is None else int(len(segs)),
+            }
             try:
                 call = _cdt_call(tool, pts, segs)
                 times, cpu, ntri = [], [], None
@@ -193,9 +210,15 @@ def cdt_mem_job(job: dict) -> dict:
     ntri = call()
     t = time.perf_counter() - t0
     mem = probe.stop_mib()
-    return {"tool": tool, "n": int(job["n"]), "triangles": int(ntri), "mem_mib": mem,
-            "time": t, "bytes_per_triangle": mem * 1024 * 1024 / max(ntri, 1),
-            "mem_method": probe.method}
+    return {
+        "tool": tool,
+        "n": int(job["n"]),
+        "triangles": int(ntri),
+        "mem_mib": mem,
+        "time": t,
+        "bytes_per_triangle": mem * 1024 * 1024 / max(ntri, 1),
+        "mem_method": probe.method,
+    }
 
 
 def main(argv=None) -> int:

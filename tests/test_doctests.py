@@ -2,6 +2,7 @@
 installed wheel in CI, ``src/`` with ``PYTHONPATH=src``): one test per module, so a
 failing example names its module.  Each runs in a fresh temporary directory, since
 some examples write files."""
+
 import doctest
 import importlib
 import pkgutil
@@ -36,6 +37,7 @@ def test_module_doctests(name, tmp_path, monkeypatch):
         pytest.importorskip(NEEDS[name], reason=f"{name}'s examples need {NEEDS[name]}")
     try:
         import matplotlib
+
         matplotlib.use("Agg")
     except ImportError:
         pass
@@ -44,7 +46,7 @@ def test_module_doctests(name, tmp_path, monkeypatch):
     flags = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
     finder = doctest.DocTestFinder(exclude_empty=True)
     runner = doctest.DocTestRunner(optionflags=flags)
-    for test in finder.find(module, name):     # globals: a copy of the module's
+    for test in finder.find(module, name):  # globals: a copy of the module's
         runner.run(test)
     result = runner.summarize(verbose=False)
     assert result.failed == 0, f"{result.failed} of {result.attempted} examples failed in {name}"

@@ -16,6 +16,7 @@ class (the case as JSON, exactly: WKB and repr floats; the error and traceback),
 ``summary.json``, and the worker's scratch files.  Printed: domains meshed, failures
 by class, and where their inputs are.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -39,8 +40,9 @@ def _paths():
     # the fuzz domains from tests/; aftmesh from src/ if its kernel was built there
     # (setup.py build_ext --inplace), otherwise the installed one
     paths = [ROOT / "tests"]
-    if any((ROOT / "src" / "aftmesh").glob("_kernel*.so")) or \
-            any((ROOT / "src" / "aftmesh").glob("_kernel*.pyd")):
+    if any((ROOT / "src" / "aftmesh").glob("_kernel*.so")) or any(
+        (ROOT / "src" / "aftmesh").glob("_kernel*.pyd")
+    ):
         paths.append(ROOT / "src")
     for p in paths:
         if str(p) not in sys.path:
@@ -79,25 +81,25 @@ class _Stop(Exception):
 def worker(args) -> int:
     """Mesh cases until the deadline; the parent watches ``current.json``."""
     _paths()
+    import fuzz_domains as fd
     from hypothesis import HealthCheck, Phase, given, seed, settings
 
-    import fuzz_domains as fd
-
     if args.memory_gb:
-        lim = int(args.memory_gb * 2 ** 30)
+        lim = int(args.memory_gb * 2**30)
         resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
     out = Path(args.out)
     stats_path = out / f"worker-{args.worker_id}.json"
     kinds = args.kinds or sorted(fd.GENERATORS)
-    counts = Counter()               # per kind: meshed, refused
-    failures = Counter()             # per failure class
+    counts = Counter()  # per kind: meshed, refused
+    failures = Counter()  # per failure class
     examples: dict[str, list] = {}
     seq = 0
     last_stats = time.time()
 
     def save_stats():
-        _write_json(stats_path, {"counts": dict(counts), "failures": dict(failures),
-                                 "examples": examples})
+        _write_json(
+            stats_path, {"counts": dict(counts), "failures": dict(failures), "examples": examples}
+        )
 
     def one(case):
         nonlocal seq, last_stats
@@ -111,16 +113,22 @@ def worker(args) -> int:
             mesh = fd.run_case(case)
         except (KeyboardInterrupt, _Stop):
             raise
-        except BaseException as exc:          # noqa: BLE001 - every failure is counted
+        except BaseException as exc:  # noqa: BLE001 - every failure is counted
             key = failure_class(exc)
             failures[key] += 1
             counts[base + ":failed"] += 1
             files = examples.setdefault(key, [])
             if len(files) < args.keep:
                 name = f"fail-{_slug(key)}-w{args.worker_id}-{failures[key]}.json"
-                _write_json(out / name, {"class": key, "error": repr(exc)[:2000],
-                                         "traceback": traceback.format_exc()[-4000:],
-                                         "case": fd.case_to_json(case)})
+                _write_json(
+                    out / name,
+                    {
+                        "class": key,
+                        "error": repr(exc)[:2000],
+                        "traceback": traceback.format_exc()[-4000:],
+                        "case": fd.case_to_json(case),
+                    },
+                )
                 files.append(name)
             save_stats()
         else:
@@ -135,9 +143,14 @@ def worker(args) -> int:
             kind = kinds[r % len(kinds)]
             rich = (r // len(kinds)) % 2 == 1
 
-            @settings(max_examples=args.chunk, database=None, derandomize=False,
-                      deadline=None, phases=[Phase.generate],
-                      suppress_health_check=list(HealthCheck))
+            @settings(
+                max_examples=args.chunk,
+                database=None,
+                derandomize=False,
+                deadline=None,
+                phases=[Phase.generate],
+                suppress_health_check=list(HealthCheck),
+            )
             @seed(args.seed * 1_000_003 + r)
             @given(fd.fuzz_cases(kinds=[kind], rich_options=rich))
             def run(case):
@@ -168,18 +181,37 @@ def supervise(args) -> int:
         cur = out / "current.json"
         if cur.exists():
             cur.unlink()
-        cmd = [sys.executable, str(Path(__file__).resolve()), "--worker",
-               "--out", str(out), "--seed", str(args.seed * 1000 + worker_id),
-               "--worker-id", str(worker_id), "--deadline", repr(deadline),
-               "--chunk", str(args.chunk), "--keep", str(args.keep),
-               "--memory-gb", str(args.memory_gb)]
+        cmd = [
+            sys.executable,
+            str(Path(__file__).resolve()),
+            "--worker",
+            "--out",
+            str(out),
+            "--seed",
+            str(args.seed * 1000 + worker_id),
+            "--worker-id",
+            str(worker_id),
+            "--deadline",
+            repr(deadline),
+            "--chunk",
+            str(args.chunk),
+            "--keep",
+            str(args.keep),
+            "--memory-gb",
+            str(args.memory_gb),
+        ]
         if args.kinds:
             cmd += ["--kinds", *args.kinds]
         env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), str(ROOT / "tests"),
-                                             env.get("PYTHONPATH", "")])
-        proc = subprocess.Popen(cmd, env=env, stdout=subprocess.DEVNULL,
-                                stderr=open(out / f"worker-{worker_id}.log", "w"))
+        env["PYTHONPATH"] = os.pathsep.join(
+            [str(ROOT / "src"), str(ROOT / "tests"), env.get("PYTHONPATH", "")]
+        )
+        proc = subprocess.Popen(
+            cmd,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=open(out / f"worker-{worker_id}.log", "w"),
+        )
         last_seq, last_change = None, time.time()
         hung = False
         while proc.poll() is None:
@@ -208,8 +240,11 @@ def supervise(args) -> int:
                 examples.setdefault(k, []).extend(files)
         rc = proc.returncode
         if hung or (rc is not None and rc != 0):
-            key = (f"hang: no progress for {args.timeout:g} s" if hung
-                   else f"crash: worker died with {'signal ' + str(-rc) if rc < 0 else 'exit code ' + str(rc)}")
+            key = (
+                f"hang: no progress for {args.timeout:g} s"
+                if hung
+                else "crash: worker died with " + (f"signal {-rc}" if rc < 0 else f"exit code {rc}")
+            )
             failures[key] += 1
             try:
                 case = json.loads(cur.read_text())["case"]
@@ -221,26 +256,40 @@ def supervise(args) -> int:
             if len(files) < args.keep and case is not None:
                 name = f"fail-{_slug(key)}-w{worker_id}.json"
                 log = (out / f"worker-{worker_id}.log").read_text()[-4000:]
-                _write_json(out / name, {"class": key, "error": key, "traceback": log,
-                                         "case": case})
+                _write_json(
+                    out / name, {"class": key, "error": key, "traceback": log, "case": case}
+                )
                 files.append(name)
             print(f"[fuzz] worker {worker_id}: {key}", flush=True)
     elapsed = time.time() - start
     meshed = sum(v for k, v in totals.items() if k.endswith(":meshed"))
     refused = sum(v for k, v in totals.items() if k.endswith(":refused"))
     failed = sum(v for k, v in totals.items() if k.endswith(":failed"))
-    summary = {"minutes": elapsed / 60, "seed": args.seed, "domains": meshed + refused + failed,
-               "meshed": meshed, "refused_ok": refused, "failed": failed,
-               "by_kind": dict(sorted(totals.items())), "failures": dict(failures.most_common()),
-               "examples": examples, "workers": worker_id}
+    summary = {
+        "minutes": elapsed / 60,
+        "seed": args.seed,
+        "domains": meshed + refused + failed,
+        "meshed": meshed,
+        "refused_ok": refused,
+        "failed": failed,
+        "by_kind": dict(sorted(totals.items())),
+        "failures": dict(failures.most_common()),
+        "examples": examples,
+        "workers": worker_id,
+    }
     _write_json(out / "summary.json", summary)
     print(f"aftmesh fuzz: {elapsed / 60:.1f} min, seed {args.seed}, {worker_id} worker(s)")
-    print(f"  domains generated: {summary['domains']}  (meshed and verified: {meshed}, "
-          f"acceptable refusals: {refused}, failed: {failed})")
-    kinds = sorted({k.split(':')[0] for k in totals})
+    print(
+        f"  domains generated: {summary['domains']}  (meshed and verified: {meshed}, "
+        f"acceptable refusals: {refused}, failed: {failed})"
+    )
+    kinds = sorted({k.split(":")[0] for k in totals})
     for k in kinds:
         row = {s: totals.get(f"{k}:{s}", 0) for s in ("meshed", "refused", "failed")}
-        print(f"    {k:12s} meshed {row['meshed']:6d}  refused {row['refused']:5d}  failed {row['failed']:5d}")
+        print(
+            f"    {k:12s} meshed {row['meshed']:6d}  refused {row['refused']:5d}  "
+            f"failed {row['failed']:5d}"
+        )
     if failures:
         print("  failures by class:")
         for key, n in failures.most_common():
@@ -256,6 +305,7 @@ def replay(path: str) -> int:
     """Run one saved case again and print what happens."""
     _paths()
     import fuzz_domains as fd
+
     d = json.loads(Path(path).read_text())
     case = fd.case_from_json(d.get("case", d))
     print(case)
@@ -263,11 +313,14 @@ def replay(path: str) -> int:
     t = time.perf_counter()
     try:
         mesh = fd.run_case(case)
-    except BaseException:                     # noqa: BLE001
+    except BaseException:  # noqa: BLE001
         traceback.print_exc()
         return 1
-    print("ok:", "refused (acceptable)" if mesh is None else mesh,
-          f"({time.perf_counter() - t:.2f} s)")
+    print(
+        "ok:",
+        "refused (acceptable)" if mesh is None else mesh,
+        f"({time.perf_counter() - t:.2f} s)",
+    )
     return 0
 
 
@@ -276,13 +329,15 @@ def main(argv=None) -> int:
     ap.add_argument("--minutes", type=float, default=10.0)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--out", default="fuzz-out")
-    ap.add_argument("--timeout", type=float, default=120.0,
-                    help="seconds without progress that count as a hang")
+    ap.add_argument(
+        "--timeout", type=float, default=120.0, help="seconds without progress that count as a hang"
+    )
     ap.add_argument("--kinds", nargs="*", help="generators to use (default: all)")
     ap.add_argument("--chunk", type=int, default=25, help="examples per hypothesis run")
     ap.add_argument("--keep", type=int, default=5, help="inputs kept per failure class")
-    ap.add_argument("--memory-gb", type=float, default=8.0,
-                    help="address-space limit of the worker (0: none)")
+    ap.add_argument(
+        "--memory-gb", type=float, default=8.0, help="address-space limit of the worker (0: none)"
+    )
     ap.add_argument("--replay", help="run one saved failure file again")
     ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--worker-id", type=int, default=0, help=argparse.SUPPRESS)

@@ -4,6 +4,7 @@ A restructuring that must not change behaviour is checked by running this before
 after and comparing: ``python tools/mesh_hashes.py > before.json`` then
 ``python tools/mesh_hashes.py --compare before.json``.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -17,8 +18,9 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.join(HERE, "..", "tests"))
 
-import aftmesh  # noqa: E402
 from domain_cases import TRIANGLE_SAMPLES, shapely_cases, triangle_sample  # noqa: E402
+
+import aftmesh  # noqa: E402
 
 
 def _digest(mesh) -> str:
@@ -38,6 +40,7 @@ def cases():
         case = triangle_sample(name)
         yield "poly-" + name, case.domain, case.size
     from aftmesh import examples
+
     for name in ("airfoil_channel", "inclusion"):
         dom, size = getattr(examples, name)()
         yield "example-" + name, dom, size

@@ -4,12 +4,29 @@ Delaunay triangulation.
 The main entry points are :func:`generate` (a quality mesh of a domain) and
 :func:`cdt` (the constrained Delaunay triangulation of a planar straight-line graph).
 """
-from .cdt import cdt
-from .generate import generate
-from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
-                     InvalidOptionError, InvalidSizeError, KernelError)
-from .mesh import Mesh
-from ._version import __version__
 
-__all__ = ["__version__", "cdt", "generate", "Mesh", "InvalidInputError", "InvalidDomainError",
-           "CrossingSegmentsError", "InvalidSizeError", "InvalidOptionError", "KernelError"]
+from ._version import __version__
+from .cdt import cdt
+from .errors import (
+    CrossingSegmentsError,
+    InvalidDomainError,
+    InvalidInputError,
+    InvalidOptionError,
+    InvalidSizeError,
+    KernelError,
+)
+from .generate import generate
+from .mesh import Mesh
+
+__all__ = [
+    "__version__",
+    "cdt",
+    "generate",
+    "Mesh",
+    "InvalidInputError",
+    "InvalidDomainError",
+    "CrossingSegmentsError",
+    "InvalidSizeError",
+    "InvalidOptionError",
+    "KernelError",
+]

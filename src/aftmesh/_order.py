@@ -6,6 +6,7 @@ consecutive points that are close on a Hilbert curve keep those walks short, and
 random rounds keep the expected amount of flipping linear (Amenta, Choi & Rote's BRIO).
 The seed is fixed, so the order, and therefore the output, is deterministic.
 """
+
 from __future__ import annotations
 
 import numpy as np

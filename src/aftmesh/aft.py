@@ -13,6 +13,7 @@ In the CDT representation R can be refused but not forced: Check_visible answers
 condition under which checking visibility from the midpoint of E is enough and T(E, R)
 is a triangle of the unmeshed region's CDT once R is inserted.
 """
+
 from __future__ import annotations
 
 __all__ = ["Strategy", "basic_aft"]
@@ -51,8 +52,13 @@ class Strategy:
     @property
     def is_builtin(self) -> bool:
         """True when no subtask is overridden (the compiled loop can run instead)."""
-        names = ("get_next_edge", "compute_new_candidate", "new_is_preferred",
-                 "mesh_size_constraint", "is_crowded")
+        names = (
+            "get_next_edge",
+            "compute_new_candidate",
+            "new_is_preferred",
+            "mesh_size_constraint",
+            "is_crowded",
+        )
         return all(getattr(type(self), n) is getattr(Strategy, n) for n in names)
 
 
@@ -66,8 +72,9 @@ def basic_aft(kernel, strategy: Strategy) -> None:
             break
         rx, ry, h = strategy.compute_new_candidate(kernel, E)
         S = kernel.compute_existing_candidate(E)
-        new = (strategy.new_is_preferred(kernel, E, (rx, ry), S, h)
-               and not strategy.mesh_size_constraint(kernel, E, (rx, ry)))
+        new = strategy.new_is_preferred(
+            kernel, E, (rx, ry), S, h
+        ) and not strategy.mesh_size_constraint(kernel, E, (rx, ry))
         if new:
             new, _left, _right = kernel.check_visible(E, rx, ry)
             if new:

@@ -4,6 +4,7 @@ Every problem with the caller's input is a ``ValueError`` subclass whose message
 the offending ring, segment, index or value.  ``KernelError`` (a ``RuntimeError``) means
 an internal invariant broke: a bug in aftmesh, never the user's fault.
 """
+
 from ._kernel import KernelError  # noqa: F401  (re-exported)
 
 

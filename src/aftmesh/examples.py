@@ -10,6 +10,7 @@ Each builder returns ``(domain, size)`` ready for :func:`aftmesh.generate`:
 
 Lengths are in chords (airfoil) or in the outer rectangle's units (inclusion).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -45,8 +46,10 @@ class GradedSize:
 
     def __init__(self, geometry, h_near: float, h_far: float, rate: float = 0.25):
         if not (0 < h_near <= h_far) or not rate > 0:
-            raise ValueError(f"need 0 < h_near <= h_far and rate > 0, got "
-                             f"h_near={h_near!r}, h_far={h_far!r}, rate={rate!r}")
+            raise ValueError(
+                f"need 0 < h_near <= h_far and rate > 0, got "
+                f"h_near={h_near!r}, h_far={h_far!r}, rate={rate!r}"
+            )
         self.geometry = geometry
         self.h_near = float(h_near)
         self.h_far = float(h_far)
@@ -57,8 +60,7 @@ class GradedSize:
         self._saturation = (self.h_far - self.h_near) / self.rate
 
     def __call__(self, x, y) -> np.ndarray:
-        x, y = np.broadcast_arrays(np.asarray(x, dtype=np.float64),
-                                   np.asarray(y, dtype=np.float64))
+        x, y = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
         xmin, ymin, xmax, ymax = self._bounds
         # the distance to the bounding box is a cheap lower bound of the distance to
         # the geometry: exact distances (the costly part) are only needed near it
@@ -71,8 +73,10 @@ class GradedSize:
         return np.minimum(self.h_far, self.h_near + self.rate * d)
 
     def __repr__(self) -> str:
-        return (f"GradedSize({self.geometry.geom_type}, h_near={self.h_near:g}, "
-                f"h_far={self.h_far:g}, rate={self.rate:g})")
+        return (
+            f"GradedSize({self.geometry.geom_type}, h_near={self.h_near:g}, "
+            f"h_far={self.h_far:g}, rate={self.rate:g})"
+        )
 
 
 def naca0012(spacing: float = 0.01, thickness: float = 0.12) -> np.ndarray:
@@ -110,10 +114,13 @@ def naca0012(spacing: float = 0.01, thickness: float = 0.12) -> np.ndarray:
         raise ValueError(f"spacing must be positive, got {spacing!r}")
     # a dense cosine-spaced sampling (dense at the round nose) to measure arc length
     beta = np.linspace(0.0, np.pi, 4001)
-    x = 0.5 * (1.0 - np.cos(beta))[::-1]          # from the trailing edge to the nose
-    yt = 5.0 * thickness * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x ** 2
-                            + 0.2843 * x ** 3 - 0.1036 * x ** 4)
-    yt = np.maximum(yt, 0.0)                      # rounding leaves -1e-17 at x = 1
+    x = 0.5 * (1.0 - np.cos(beta))[::-1]  # from the trailing edge to the nose
+    yt = (
+        5.0
+        * thickness
+        * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
+    )
+    yt = np.maximum(yt, 0.0)  # rounding leaves -1e-17 at x = 1
     s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(yt)))])
     pieces = max(4, int(np.ceil(s[-1] / spacing)))
     t = np.linspace(0.0, s[-1], pieces + 1)
@@ -125,8 +132,9 @@ def naca0012(spacing: float = 0.01, thickness: float = 0.12) -> np.ndarray:
     return np.concatenate([upper, lower])
 
 
-def airfoil_channel(alpha: float = 4.0, h_near: float = 0.01, h_far: float = 0.125,
-                    rate: float = 0.25):
+def airfoil_channel(
+    alpha: float = 4.0, h_near: float = 0.01, h_far: float = 0.125, rate: float = 0.25
+):
     """A NACA 0012 airfoil of chord 1 at angle of attack ``alpha`` in a channel.
 
     The channel is the rectangle [-1.5, 3.5] x [-1.25, 1.25]; the airfoil's leading
