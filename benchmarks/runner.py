@@ -71,6 +71,8 @@ def locate_aftmesh() -> str:
             where = "src/ (kernel built in place)" if len(parts) > 1 else "the installed packages"
             raise SetupError(f"cannot import aftmesh from {where}: {tail}\n{HOW_TO_BUILD}")
         _AFTMESH.update(parts=parts, file=probe.stdout.strip())
+        if len(parts) > 1 and str(SRC) not in sys.path:
+            sys.path.insert(0, str(SRC))  # this process checks availability the same way
     return _AFTMESH["file"]
 
 
