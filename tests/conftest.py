@@ -37,12 +37,16 @@ def _timing_on(config) -> bool:
 
 
 def pytest_collection_modifyitems(config, items):
-    if _timing_on(config):
-        return
+    """Tests marked ``timing`` are skipped by default; tests using ``time_limit`` run
+    by default (their thresholds unchecked) and get the marker, so ``-m timing``
+    selects them with the thresholds checked."""
     skip = pytest.mark.skip(reason=f"wall-clock test: set {TIMING_ENV}=1 or use -m timing")
+    timing_on = _timing_on(config)
     for item in items:
-        if "timing" in item.keywords:
+        if item.get_closest_marker("timing") is not None and not timing_on:
             item.add_marker(skip)
+        elif "time_limit" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.timing)
 
 
 @pytest.fixture
