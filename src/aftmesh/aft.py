@@ -16,36 +16,43 @@ is a triangle of the unmeshed region's CDT once R is inserted.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ._kernel import Triangulation
+
 __all__ = ["Strategy", "basic_aft"]
 
 
 class Strategy:
-    """The built-in subtasks.  Subclass and override any of the four methods.
+    """The built-in subtasks.  Subclass and override any of the five methods.
 
     Each method receives the kernel (``aftmesh._kernel.Triangulation``) and the current
     edge E as a half-edge index; ``kernel.edge(E)`` gives its end vertices and
     ``kernel.vertex(v)`` a vertex's coordinates.
     """
 
-    def get_next_edge(self, kernel) -> int:
+    def get_next_edge(self, kernel: Triangulation) -> int:
         """Any front edge (minimal requirement); -1 when the front is empty.
         Built in: the kernel's heap (shortest, longest or oldest first)."""
         return kernel.get_next_edge()
 
-    def compute_new_candidate(self, kernel, E: int) -> tuple[float, float, float]:
+    def compute_new_candidate(self, kernel: Triangulation, E: int) -> tuple[float, float, float]:
         """A point R on the left of E, and the local target size h: (x, y, h)."""
         return kernel.compute_new_candidate(E)
 
-    def new_is_preferred(self, kernel, E: int, R: tuple[float, float], S: int, h: float) -> bool:
+    def new_is_preferred(
+        self, kernel: Triangulation, E: int, R: tuple[float, float], S: int, h: float
+    ) -> bool:
         """Whether to try R rather than the existing candidate S (must be false when
         they coincide)."""
         return kernel.new_is_preferred(E, R[0], R[1], S, h)
 
-    def mesh_size_constraint(self, kernel, E: int, R: tuple[float, float]) -> bool:
+    def mesh_size_constraint(self, kernel: Triangulation, E: int, R: tuple[float, float]) -> bool:
         """True to refuse a new vertex now (formulas (4) and (5))."""
         return kernel.mesh_size_constraint(E, R[0], R[1])
 
-    def is_crowded(self, kernel, E: int, R: tuple[float, float], h: float) -> bool:
+    def is_crowded(self, kernel: Triangulation, E: int, R: tuple[float, float], h: float) -> bool:
         """New_is_preferred's proximity rule, asked once Check_visible has located R."""
         return kernel.is_crowded(E, R[0], R[1], h)
 
@@ -62,7 +69,7 @@ class Strategy:
         return all(getattr(type(self), n) is getattr(Strategy, n) for n in names)
 
 
-def basic_aft(kernel, strategy: Strategy) -> None:
+def basic_aft(kernel: Triangulation, strategy: Strategy) -> None:
     """Run Basic_aft on a kernel whose domain CDT is built (every domain triangle
     unmeshed) and whose size field and options are set."""
     kernel.convert_to_frontal_edge_set()

@@ -20,9 +20,13 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from . import __version__
 from .errors import InvalidInputError, KernelError
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["main"]
 
@@ -46,7 +50,7 @@ def _have(module: str) -> bool:
     return True
 
 
-def _summary(mesh, seconds: float | None = None) -> list[str]:
+def _summary(mesh: Mesh, seconds: float | None = None) -> list[str]:
     """The lines the demo and ``mesh --stats`` print about a mesh."""
     q = mesh.quality()
     lines = [
@@ -67,7 +71,12 @@ def _summary(mesh, seconds: float | None = None) -> list[str]:
 
 
 def _write_outputs(
-    mesh, stem: Path, png: bool, have_meshio: bool, zoom=None, color_by: str = "quality"
+    mesh: Mesh,
+    stem: Path,
+    png: bool,
+    have_meshio: bool,
+    zoom: tuple[float, float, float, float] | None = None,
+    color_by: str = "quality",
 ) -> list[Path]:
     written = []
     if have_meshio:
@@ -85,7 +94,7 @@ def _write_outputs(
     return written
 
 
-def _demo(args) -> int:
+def _demo(args: argparse.Namespace) -> int:
     from . import examples
     from .generate import generate
 
@@ -141,7 +150,7 @@ def _demo(args) -> int:
     return 0
 
 
-def _read_domain(path: Path):
+def _read_domain(path: Path) -> Any:
     from . import io
 
     reader = _INPUT_READERS.get(path.suffix.lower())
@@ -152,7 +161,7 @@ def _read_domain(path: Path):
     return getattr(io, reader)(path)
 
 
-def _mesh(args) -> int:
+def _mesh(args: argparse.Namespace) -> int:
     from .generate import generate
     from .io import mesh_format
 

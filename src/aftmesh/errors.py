@@ -5,6 +5,8 @@ the offending ring, segment, index or value.  ``KernelError`` (a ``RuntimeError`
 an internal invariant broke: a bug in aftmesh, never the user's fault.
 """
 
+from collections.abc import Iterable
+
 from ._kernel import KernelError  # noqa: F401  (re-exported)
 
 
@@ -20,7 +22,7 @@ class InvalidDomainError(InvalidInputError):
 class CrossingSegmentsError(InvalidDomainError):
     """Two input segments cross; ``segments`` holds the indices of both."""
 
-    def __init__(self, msg, segments=()):
+    def __init__(self, msg: str, segments: Iterable[int] = ()) -> None:
         super().__init__(msg)
         self.segments = tuple(segments)
 

@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
+from numpy.typing import ArrayLike
 from shapely.geometry import Polygon, box
+from shapely.geometry.base import BaseGeometry
 
 __all__ = ["GradedSize", "naca0012", "airfoil_channel", "inclusion"]
 
@@ -44,7 +46,9 @@ class GradedSize:
     [0.1, 0.3, 0.5]
     """
 
-    def __init__(self, geometry, h_near: float, h_far: float, rate: float = 0.25):
+    def __init__(
+        self, geometry: BaseGeometry, h_near: float, h_far: float, rate: float = 0.25
+    ) -> None:
         if not (0 < h_near <= h_far) or not rate > 0:
             raise ValueError(
                 f"need 0 < h_near <= h_far and rate > 0, got "
@@ -59,7 +63,7 @@ class GradedSize:
         # beyond this distance the size is h_far whatever the exact distance
         self._saturation = (self.h_far - self.h_near) / self.rate
 
-    def __call__(self, x, y) -> np.ndarray:
+    def __call__(self, x: ArrayLike, y: ArrayLike) -> np.ndarray:
         x, y = np.broadcast_arrays(np.asarray(x, dtype=np.float64), np.asarray(y, dtype=np.float64))
         xmin, ymin, xmax, ymax = self._bounds
         # the distance to the bounding box is a cheap lower bound of the distance to
@@ -134,7 +138,7 @@ def naca0012(spacing: float = 0.01, thickness: float = 0.12) -> np.ndarray:
 
 def airfoil_channel(
     alpha: float = 4.0, h_near: float = 0.01, h_far: float = 0.125, rate: float = 0.25
-):
+) -> tuple[Polygon, GradedSize]:
     """A NACA 0012 airfoil of chord 1 at angle of attack ``alpha`` in a channel.
 
     The channel is the rectangle [-1.5, 3.5] x [-1.25, 1.25]; the airfoil's leading
@@ -172,7 +176,9 @@ def airfoil_channel(
     return domain, size
 
 
-def inclusion(h_core: float = 0.04, h_far: float = 0.15, rate: float = 0.25):
+def inclusion(
+    h_core: float = 0.04, h_far: float = 0.15, rate: float = 0.25
+) -> tuple[list[Polygon], GradedSize]:
     """Two materials: a 3 x 2 rectangle with a 1 x 1 core in its middle.
 
     After the two-material domain of the paper's Figure 2: the mesh must follow the
