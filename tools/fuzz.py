@@ -36,13 +36,17 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parent.parent
 
 
+def _src_has_kernel() -> bool:
+    """Whether the kernel was built in place in src/ (setup.py build_ext --inplace)."""
+    pkg = ROOT / "src" / "aftmesh"
+    return any(pkg.glob("_kernel*.so")) or any(pkg.glob("_kernel*.pyd"))
+
+
 def _paths():
-    # the fuzz domains from tests/; aftmesh from src/ if its kernel was built there
-    # (setup.py build_ext --inplace), otherwise the installed one
+    # the fuzz domains from tests/; aftmesh from src/ if its kernel was built there,
+    # otherwise the installed one
     paths = [ROOT / "tests"]
-    if any((ROOT / "src" / "aftmesh").glob("_kernel*.so")) or any(
-        (ROOT / "src" / "aftmesh").glob("_kernel*.pyd")
-    ):
+    if _src_has_kernel():
         paths.append(ROOT / "src")
     for p in paths:
         if str(p) not in sys.path:
@@ -203,9 +207,9 @@ def supervise(args) -> int:
         if args.kinds:
             cmd += ["--kinds", *args.kinds]
         env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(
-            [str(ROOT / "src"), str(ROOT / "tests"), env.get("PYTHONPATH", "")]
-        )
+        # the workers import the same aftmesh as this process (see _paths)
+        src = [str(ROOT / "src")] if _src_has_kernel() else []
+        env["PYTHONPATH"] = os.pathsep.join([*src, str(ROOT / "tests"), env.get("PYTHONPATH", "")])
         proc = subprocess.Popen(
             cmd,
             env=env,
