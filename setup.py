@@ -10,6 +10,7 @@ Cython writes the generated C file under ``build/cython/``, never next to the
 sources, so the source tree (and the sdist made from it) holds only ``.pyx``,
 ``.pxi``, ``.pxd`` and ``.h`` files.
 """
+
 import os
 
 from Cython.Build import cythonize
