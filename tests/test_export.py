@@ -152,6 +152,14 @@ def test_physical_groups_of_markers_without_names(checked):
         "segment_marker_7": [10, 1]}
 
 
+def test_every_group_keeps_a_name_of_its_own(tagged):
+    m = with_tags(tagged, np.minimum(tagged.segment_tags, 1), {"untagged": 1})
+    _, seg, names = gmsh_physical_groups(m)
+    assert {k: v.tolist() for k, v in names.items()} == {
+        "region_0": [1, 2], "region_1": [2, 2], "untagged": [3, 1], "untagged_4": [4, 1]}
+    np.testing.assert_array_equal(seg, np.where(m.segment_tags == 1, 3, 4))
+
+
 def test_negative_regions_still_get_positive_groups(checked):
     square = {"vertices": [(0, 0), (2, 0), (2, 1), (0, 1), (1, 0), (1, 1)],
               "segments": [(0, 4), (4, 1), (1, 2), (2, 5), (5, 3), (3, 0), (4, 5)],

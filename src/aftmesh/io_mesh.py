@@ -5,14 +5,19 @@ The segments go out as a block of line cells beside the triangles wherever the f
 holds mixed cells (:data:`LINE_FORMATS`), so a solver finds its boundary parts:
 
 * Gmsh (``.msh``): physical groups with names (``$PhysicalNames``).  Triangles of
-  region r are in group r + 1 (Gmsh reads group 0 as "no group").  The segments'
-  groups come after the regions': with ``R`` the largest region group, a segment
-  tagged k (``Mesh.segment_tags``, names from ``Mesh.tag_names``) is in group R + k
-  and untagged segments in one group named ``untagged`` after those; without tags, a
-  segment of marker m is in group R + m + 1, named after its input ring or line when
-  the mesh knows it (``info['sources']``), else ``segment_marker_<m>``.  Groups are
+  region r are in group r + 1, named ``region_<r>`` (Gmsh reads group 0 as "no
+  group"; negative region markers shift every group up so the smallest is 1).  The
+  segments' groups come after the regions': with ``R`` the largest region group, on a
+  tagged mesh (``Mesh.segment_tags`` with ``Mesh.tag_names``) a segment tagged k is in
+  group R + k, named by its tag, and untagged segments in one group named
+  ``untagged`` after those; otherwise a segment of marker m is in group R + m + 1
+  (shifted likewise for negative markers, such as -1 for a segment of unknown
+  origin), named after its input ring or line when the mesh knows it
+  (``info['sources']``), else ``segment_marker_<m>``.  Groups are
   per dimension in Gmsh, but readers such as scikit-fem's look a name up by its
-  number alone, so no two groups share a number.
+  number alone, so no two groups share a number.  (Gmsh 4.1, ``file_format='gmsh'``,
+  gets the triangles and their region groups only: meshio writes it with one cell
+  type unless given Gmsh's entity information.)
 * The other formats with the line block: cell data ``region`` (-1 on segments),
   ``segment_marker`` (-1 on triangles) and, when the mesh has them, ``segment_tag``
   (0 on triangles) and ``segment_source`` (-1 on triangles).
@@ -75,6 +80,15 @@ def _marker_names(mesh) -> dict[int, str]:
     return {i: str(name) for i, name in enumerate(sources)}
 
 
+def _add_group(names: dict, name: str, tag: int, dim: int) -> None:
+    """Add a physical group's name; a name already taken (a ring named like a region,
+    a tag named ``untagged``) gets the group's number appended, so each group keeps
+    a name of its own."""
+    if name in names:
+        name = f"{name}_{tag}"
+    names[name] = np.array([tag, dim])
+
+
 def gmsh_physical_groups(mesh) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
     """The Gmsh physical groups :func:`write_mesh` gives a mesh (see the module notes).
 
@@ -106,19 +120,17 @@ def gmsh_physical_groups(mesh) -> tuple[np.ndarray, np.ndarray, dict[str, np.nda
         by_tag = {int(k): str(name) for name, k in tag_names.items()}
         last = max([*by_tag, int(tags.max()) if s else 0])
         seg = np.where(tags > 0, top + tags, top + last + 1).astype(np.int64)
-        for k in np.unique(tags).tolist():
-            if k > 0:
-                names[by_tag.get(k, f"segment_tag_{k}")] = np.array([top + k, 1])
-            else:
-                untagged = _UNTAGGED if _UNTAGGED not in by_tag.values() else "untagged_segments"
-                names[untagged] = np.array([top + last + 1, 1])
+        # the user's names first: a clash renames the group of untagged segments
+        for k in sorted(np.unique(tags).tolist(), key=lambda k: k <= 0):
+            name = by_tag.get(k, f"segment_tag_{k}") if k > 0 else _UNTAGGED
+            _add_group(names, name, top + (k if k > 0 else last + 1), 1)
     else:
         markers = np.asarray(mesh.segment_markers, dtype=np.int64)
         low = min(0, int(markers.min())) if s else 0
         seg = top + markers - low + 1
         known = _marker_names(mesh)
         for m in np.unique(markers).tolist():
-            names[known.get(m, f"segment_marker_{m}")] = np.array([top + m - low + 1, 1])
+            _add_group(names, known.get(m, f"segment_marker_{m}"), top + m - low + 1, 1)
     return tri.astype(np.int32), seg.astype(np.int32), names
 
 
