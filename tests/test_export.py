@@ -48,7 +48,13 @@ def tagged():
     aftmesh.checks.check_mesh(mesh, domain_area=outer.area + core.area)
     tags = side_tags(mesh, 3, 2)
     assert set(np.unique(tags).tolist()) == {0, 1, 2, 3, 4}
-    return with_tags(mesh, tags, SIDES)
+    out = with_tags(mesh, tags, SIDES)
+    if getattr(out, "segment_sources", None) is None:
+        # the input edge of each segment: the exterior ring's edges go right, top,
+        # left, bottom (the others are left unknown here: only the export is tested)
+        edge_of_side = np.array([-1, 2, 0, 3, 1])
+        object.__setattr__(out, "segment_sources", edge_of_side[tags].astype(np.int32))
+    return out
 
 
 def _pairs(edges):
@@ -102,6 +108,8 @@ def test_meshio_formats_keep_regions_segments_markers_and_tags(tmp_path, tagged,
     np.testing.assert_array_equal(data["segment_marker"][1], m.segment_markers)
     np.testing.assert_array_equal(data["segment_tag"][1], m.segment_tags)
     assert (data["segment_tag"][0] == 0).all()
+    np.testing.assert_array_equal(data["segment_source"][1], m.segment_sources)
+    assert (data["segment_source"][0] == -1).all()
 
 
 def test_native_formats_keep_what_they_hold(tmp_path, tagged):
