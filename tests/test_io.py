@@ -317,15 +317,20 @@ def test_meshio_round_trip(tmp_path, two_region_mesh, name, fmt):
     np.testing.assert_array_equal(back.points[:, :2], m.points)
     if back.points.shape[1] == 3:
         assert not back.points[:, 2].any()
-    (block,) = back.cells
-    assert block.type == "triangle"
-    np.testing.assert_array_equal(block.data, m.triangles)
+    # the triangles first, then the segments as line cells
+    assert [block.type for block in back.cells] == ["triangle", "line"]
+    np.testing.assert_array_equal(back.cells[0].data, m.triangles)
+    np.testing.assert_array_equal(back.cells[1].data, m.segments)
+    if name == "m.msh":
+        # Gmsh 2.2 (not ANSYS, which meshio picks for .msh); region r is group r + 1
+        assert (tmp_path / name).read_bytes().startswith(b"$MeshFormat\n2.2")
+        np.testing.assert_array_equal(back.cell_data["gmsh:physical"][0], m.regions + 1)
+        return
     key = {"m.mesh": "medit:ref"}.get(name, "region")
     np.testing.assert_array_equal(np.asarray(back.cell_data[key][0]).astype(int), m.regions)
-    if name == "m.msh":
-        # Gmsh 2.2 (not ANSYS, which meshio picks for .msh) with physical groups
-        assert (tmp_path / name).read_bytes().startswith(b"$MeshFormat\n2.2")
-        np.testing.assert_array_equal(back.cell_data["gmsh:physical"][0], m.regions)
+    key = {"m.mesh": "medit:ref"}.get(name, "segment_marker")
+    np.testing.assert_array_equal(np.asarray(back.cell_data[key][1]).astype(int),
+                                  m.segment_markers)
 
 
 def test_mesh_format_resolution():

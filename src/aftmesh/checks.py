@@ -20,6 +20,9 @@ import numpy as np
 from . import _kernel
 from .mesh import Mesh
 
+# re-exported: the one connected-components routine lives with the mesh topology
+from .topology import triangle_components
+
 __all__ = ["MeshCheckError", "check_mesh", "count_formula", "triangle_components"]
 
 
@@ -215,27 +218,6 @@ def boundary_curves(points: np.ndarray, triangles: np.ndarray) -> int:
             seen.add(edge)
             edge = succ[edge]
     return curves
-
-
-def triangle_components(mesh: Mesh) -> np.ndarray:
-    """The connected component (through shared edges) of each triangle, numbered from 0
-    in the order of their first triangles."""
-    N = np.asarray(mesh.neighbors)
-    comp = np.full(len(N), -1)
-    c = 0
-    for start in range(len(N)):
-        if comp[start] >= 0:
-            continue
-        stack = [start]
-        comp[start] = c
-        while stack:
-            u = stack.pop()
-            for w in N[u]:
-                if w >= 0 and comp[w] < 0:
-                    comp[w] = c
-                    stack.append(w)
-        c += 1
-    return comp
 
 
 def count_formula(mesh: Mesh):
