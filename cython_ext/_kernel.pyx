@@ -95,6 +95,15 @@ cdef tuple _centroid(Tri* T, int t):
     return ((a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0)
 
 
+# The named enums of halfedge.pxd, for src/aftmesh/_states.py (tests/test_states.py
+# checks that the IntEnums there hold these values).
+TRIANGLE_STATE_VALUES = dict(FREE=T_FREE, EXTERIOR=T_EXTERIOR, UNMESHED=T_UNMESHED,
+                             MESHED=T_MESHED)
+ORDER_VALUES = dict(SHORTEST=ORDER_SHORTEST, LONGEST=ORDER_LONGEST, OLDEST=ORDER_OLDEST)
+LOCATION_VALUES = dict(IN_TRIANGLE=LOC_IN_TRIANGLE, ON_EDGE=LOC_ON_EDGE,
+                       ON_VERTEX=LOC_ON_VERTEX, OUTSIDE=LOC_OUTSIDE)
+EDGE_FLAG_VALUES = dict(SEGMENT=E_SEGMENT, FIXED=E_FIXED)
+
 # Coordinates (besides 0) for which orient2d and incircle are exact (predicates.pxi).
 EXACT_COORDINATE_RANGE = (EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
 
@@ -314,9 +323,10 @@ cdef class Triangulation:
                 T.tregion[t] = r
 
     def state_at(self, double x, double y):
-        """State of the triangle holding (x, y): 1 exterior, 2 unmeshed, 3 meshed; 1
-        outside the hull; 0 when the point lies on a segment or on a vertex that a
-        segment ends at (it then belongs to no single region)."""
+        """State (T_EXTERIOR, T_UNMESHED, T_MESHED: aftmesh._states.TriangleState) of
+        the triangle holding (x, y); T_EXTERIOR outside the hull; None when the point
+        lies on a segment or on a vertex that a segment ends at (it then belongs to no
+        single region)."""
         cdef double p[2]
         cdef int where = NONE, loc
         p[0] = x
@@ -327,11 +337,11 @@ cdef class Triangulation:
             return self.T.tstate[where]
         if loc == LOC_ON_EDGE:
             if self.T.eflag[where] & E_SEGMENT:
-                return 0
+                return None
             return self.T.tstate[where // 3]
         if loc == LOC_ON_VERTEX:
             if _vertex_on_segment(&self.T, where):
-                return 0
+                return None
             return self.T.tstate[self.T.vhe[where] // 3]
         return T_EXTERIOR
 

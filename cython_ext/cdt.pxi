@@ -6,6 +6,11 @@
 # triangulation is untouched and stays a CDT).  The same routine serves the CDT of the
 # input domain and Update_internal's edges F and G.
 
+cdef enum:
+    # _insert_piece's first guess at the crossed triangles of one piece; it restarts
+    # with 4 times more when the walk outgrows it (nothing is modified before that)
+    CAVITY_INITIAL_CAP = 64
+
 
 cdef inline bint _on_ray(Tri* T, int a, int b, int x) noexcept nogil:
     """x is collinear with a-b (checked by the caller): is it on the side of b?"""
@@ -117,7 +122,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
     re-triangulation their two new half-edges are paired with each other."""
     cdef int res, h, g, w, ow, u, v, ntri, nl, nr, i, j, nused, topr, topl, t0, nc
     cdef int end = NONE
-    cdef int m = 64
+    cdef int m = CAVITY_INITIAL_CAP
     cdef int32_t* tris
     cdef int32_t* lch
     cdef int32_t* rch

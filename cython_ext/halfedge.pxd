@@ -28,28 +28,36 @@ cdef enum:
     GHOST = -1          # the vertex at infinity of ghost triangles
     NONE = -1           # no half-edge / no triangle
 
-    # eflag bits
+# The named enums below are mirrored in Python by src/aftmesh/_states.py (IntEnums);
+# tests/test_states.py checks the two agree through _kernel's *_VALUES dicts.
+
+cdef enum EdgeFlag:     # bits of eflag
     E_SEGMENT = 1       # an input edge (boundary, interface, crack): never flipped
     E_FIXED = 2         # a temporary constraint (F, G while Update_internal inserts them)
 
-    # tstate values
+cdef enum TriState:     # values of tstate
     T_FREE = 0          # slot not in use (only transiently, inside a re-triangulation)
     T_EXTERIOR = 1      # ghost triangles, outside the domain, holes
     T_UNMESHED = 2      # part of the unmeshed region S(E) of the paper
     T_MESHED = 3        # part of the mesh T built so far
 
-    # status codes returned by kernel routines (0 = success)
+cdef enum Status:       # returned by kernel routines (0 or a count = success)
     ERR_NOMEM = -1
     ERR_CROSSING = -2   # a new edge would cross a constrained edge (T.err_* say which)
     ERR_COLLINEAR = -3  # all points on one line: no triangle exists
     ERR_INTERNAL = -4   # an invariant broke: a bug, reported instead of looping or crashing
     ERR_INTERRUPTED = -5
 
-    # results of locate()
+cdef enum Location:     # results of locate()
     LOC_IN_TRIANGLE = 0
     LOC_ON_EDGE = 1
     LOC_ON_VERTEX = 2
     LOC_OUTSIDE = 3     # strictly outside the convex hull: the answer is a ghost triangle
+
+cdef enum Order:        # Get_next_edge's order of the heap
+    ORDER_SHORTEST = 0  # shortest front edge first (length classes, oldest within one)
+    ORDER_LONGEST = 1
+    ORDER_OLDEST = 2    # first in, first out
 
 cdef struct Tri:
     double* xy          # 2 doubles per vertex

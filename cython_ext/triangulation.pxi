@@ -4,6 +4,15 @@
 from libc.stdlib cimport malloc, realloc, free
 from libc.string cimport memset
 
+cdef enum:
+    SCRATCH_INITIAL_CAP = 256   # T.stack / T.buf, grown on demand
+    # locate()'s stochastic walk gives up after WALK_CAP_BASE + WALK_CAP_PER_TRIANGLE
+    # * nt steps (far beyond any real walk) and scans all triangles exactly instead
+    WALK_CAP_BASE = 64
+    WALK_CAP_PER_TRIANGLE = 4
+# any non-zero xorshift seed works; fixed so that runs are reproducible
+cdef uint32_t WALK_RNG_SEED = 2463534242u
+
 
 # ---------------------------------------------------------------- storage
 
@@ -22,12 +31,12 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.tstate = <uint8_t*> malloc(nt_cap * sizeof(uint8_t))
     T.tregion = <int32_t*> malloc(nt_cap * sizeof(int32_t))
     T.nt_cap = nt_cap
-    T.stack_cap = 256
+    T.stack_cap = SCRATCH_INITIAL_CAP
     T.stack = <int32_t*> malloc(T.stack_cap * sizeof(int32_t))
-    T.buf_cap = 256
+    T.buf_cap = SCRATCH_INITIAL_CAP
     T.buf = <int32_t*> malloc(T.buf_cap * sizeof(int32_t))
     T.last = NONE
-    T.rng = 2463534242u
+    T.rng = WALK_RNG_SEED
     if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
             or T.tstate == NULL or T.tregion == NULL or T.stack == NULL or T.buf == NULL):
         return ERR_NOMEM
@@ -342,7 +351,7 @@ cdef int locate(Tri* T, const double* p, int start, int* where) noexcept nogil:
     (so it cannot cycle forever on a constrained triangulation) and is capped; past the
     cap it falls back to an exact scan of all triangles."""
     cdef int t = start if start >= 0 else T.last
-    cdef int steps = 0, cap = 64 + 4 * T.nt
+    cdef int steps = 0, cap = WALK_CAP_BASE + WALK_CAP_PER_TRIANGLE * T.nt
     cdef int k, i, e, r
     cdef int o3[3]
     if t < 0 or t >= T.nt or T.tstate[t] == T_FREE:

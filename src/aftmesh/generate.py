@@ -7,6 +7,7 @@ import time
 import numpy as np
 import shapely
 
+from ._states import Order
 from .aft import Strategy, basic_aft
 from .boundary import discretize
 from .cdt import segment_markers
@@ -19,7 +20,7 @@ from .sizing import DEFAULT_GRADATION, make_size_field, per_region_size
 
 __all__ = ["generate"]
 
-_ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
+_ORDERS = {o.name.lower(): o for o in Order}
 MAX_SMOOTH = 1000           # smoothing rounds; it stops earlier once nothing moves
 # Kernel indices are int32: refuse a request for more triangles than that can number
 MAX_TRIANGLES = 2 ** 30

@@ -20,6 +20,7 @@ import numpy as np
 
 from . import _kernel
 from ._order import brio_order
+from ._states import TriangleState
 from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 
 # The exact predicates are exact for coordinates that are 0 or of magnitude between
@@ -186,11 +187,11 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     for name, rows in (("holes", hole_pts), ("regions", reg[:, :2])):
         for i, (x, y) in enumerate(rows):
             state = kernel.state_at(x, y)
-            if state == 0:
+            if state is None:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) lies on a segment, so it picks no "
                     "single region: put it strictly inside")
-            if state != 2:
+            if state != TriangleState.UNMESHED:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain")
     kernel.carve(hole_pts, False)
