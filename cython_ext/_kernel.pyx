@@ -39,12 +39,15 @@ class KernelError(RuntimeError):
 
 class CrossingError(ValueError):
     """A constrained edge would cross another one; ``edge`` and ``blocker`` give the
-    vertex pairs (kernel vertex indices) of the new edge and of the edge it hit."""
+    vertex pairs (kernel vertex indices) of the new edge and of the edge it hit, and
+    ``blocker_segment`` the id of the input segment the hit edge is a piece of (-1:
+    not an input segment)."""
 
-    def __init__(self, msg, edge, blocker):
+    def __init__(self, msg, edge, blocker, blocker_segment=-1):
         super().__init__(msg)
         self.edge = edge
         self.blocker = blocker
+        self.blocker_segment = blocker_segment
 
 
 class CollinearError(ValueError):
@@ -73,7 +76,7 @@ cdef object _raise_for(Tri* T, int code):
     if code == ERR_CROSSING:
         raise CrossingError(
             f"edge ({T.err_a}, {T.err_b}) crosses constrained edge ({T.err_u}, {T.err_v})",
-            (T.err_a, T.err_b), (T.err_u, T.err_v))
+            (T.err_a, T.err_b), (T.err_u, T.err_v), T.err_seg)
     if code == ERR_COLLINEAR:
         raise CollinearError("all input points are collinear: there is no triangle")
     if code == ERR_INTERRUPTED:
@@ -183,16 +186,21 @@ cdef class Triangulation:
         _raise_for(T, res)
         return merged_arr
 
-    def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT):
-        """Insert constrained edges (pairs of vertex indices).  Returns how many of
-        them ran exactly through other vertices and were split there.  On a crossing,
-        raises CrossingError with `index` set to the row that failed."""
+    def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
+                        int first_id=0):
+        """Insert constrained edges (pairs of vertex indices).  With flag E_SEGMENT,
+        row i is input segment first_id + i: every piece of it carries that id
+        (arrays()["segment_ids"]); other flags carry -1.  Returns how many of them ran
+        exactly through other vertices and were split there.  On a crossing, raises
+        CrossingError with `index` set to the row that failed."""
         cdef int i, res = 0, failed = -1, through = 0
+        cdef bint is_input = (flag & E_SEGMENT) != 0
         cdef int m = segments.shape[0]
         cdef Tri* T = &self.T
         with nogil:
             for i in range(m):
-                res = insert_segment(T, segments[i, 0], segments[i, 1], <uint8_t> flag)
+                res = insert_segment(T, segments[i, 0], segments[i, 1], <uint8_t> flag,
+                                     first_id + i if is_input else -1)
                 if res < 0:
                     failed = i
                     break
@@ -378,6 +386,11 @@ cdef class Triangulation:
                     problems.append(f"half-edge {e}: twin {f} has other end points")
                 if T.eflag[f] != T.eflag[e]:
                     problems.append(f"half-edge {e}: flags differ from twin")
+                if T.eseg[f] != T.eseg[e]:
+                    problems.append(f"half-edge {e}: segment id differs from twin")
+                if (T.eseg[e] >= 0) != ((T.eflag[e] & E_SEGMENT) != 0):
+                    problems.append(f"half-edge {e}: segment id {T.eseg[e]} with flags "
+                                    f"{T.eflag[e]}")
             if not is_ghost(T, t):
                 if orient2d(P(T, T.tv[3 * t]), P(T, T.tv[3 * t + 1]), P(T, T.tv[3 * t + 2])) <= 0:
                     problems.append(f"triangle {t}: not counter-clockwise")
@@ -392,8 +405,9 @@ cdef class Triangulation:
 
         Returns a dict: points (n, 2), triangles (t, 3) counter-clockwise, neighbors
         (t, 3) with neighbors[i, k] across the edge opposite vertex k (-1: none),
-        segments (s, 2) (constrained edges of the domain, each once), regions (t,),
-        vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
+        segments (s, 2) (constrained edges of the domain, each once), segment_ids (s,)
+        the input segment each is a piece of (see insert_segments; -1: none), regions
+        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
         cdef Tri* T = &self.T
         cdef int t, k, e, ntri = 0, nvo = 0, u
         keep_arr = np.zeros(T.nt, dtype=np.uint8)
@@ -432,6 +446,7 @@ cdef class Triangulation:
         nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
         cdef int32_t[:, ::1] nbr = nbr_arr
         segs = []
+        seg_ids = []
         for t in range(T.nt):
             if keep[t]:
                 for k in range(3):
@@ -444,9 +459,11 @@ cdef class Triangulation:
                         u = T.twin[e] // 3
                         if not keep[u] or u > t:
                             segs.append((vmap[T.tv[e]], vmap[T.tv[nxt(e)]]))
+                            seg_ids.append(T.eseg[e])
         seg_arr = np.array(segs, dtype=np.int32).reshape(-1, 2)
         return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
-                    segments=seg_arr, regions=regions_arr, vertex_map=vmap_arr)
+                    segments=seg_arr, segment_ids=np.array(seg_ids, dtype=np.int32),
+                    regions=regions_arr, vertex_map=vmap_arr)
 
     def raw(self):
         """Copies of the raw kernel arrays (for tests and debugging)."""
@@ -457,6 +474,7 @@ cdef class Triangulation:
             tv=np.asarray(<int32_t[:n3]> T.tv).copy(),
             twin=np.asarray(<int32_t[:n3]> T.twin).copy(),
             eflag=np.asarray(<uint8_t[:n3]> T.eflag).copy(),
+            eseg=np.asarray(<int32_t[:n3]> T.eseg).copy(),
             tstate=np.asarray(<uint8_t[:T.nt]> T.tstate).copy(),
             tregion=np.asarray(<int32_t[:T.nt]> T.tregion).copy(),
             vhe=np.asarray(<int32_t[:T.nv]> T.vhe).copy())

@@ -63,6 +63,7 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
     """
     cdef int top = NONE, sp = 0, lo, hi, par, c, j, t, tw0, tw1
     cdef uint8_t f0, f1
+    cdef int32_t i0, i1
     if reserve_stack(T, 3 * (n + 2)):
         return ERR_NOMEM
     T.stack[0] = 0
@@ -82,19 +83,24 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
         nused[0] += 1
         tw0 = NONE
         f0 = 0
+        i0 = -1
         if c == lo + 1:
             newhe[lo] = 3 * t
             tw0 = ext[lo]
             if tw0 >= 0:
                 f0 = T.eflag[tw0]
+                i0 = T.eseg[tw0]
         tw1 = NONE
         f1 = 0
+        i1 = -1
         if hi == c + 1:
             newhe[c] = 3 * t + 1
             tw1 = ext[c]
             if tw1 >= 0:
                 f1 = T.eflag[tw1]
-        set_tri(T, t, chain[lo], chain[c], chain[hi], tw0, tw1, par, f0, f1, 0, state, region)
+                i1 = T.eseg[tw1]
+        set_tri(T, t, chain[lo], chain[c], chain[hi], tw0, tw1, par, f0, f1, 0, i0, i1, -1,
+                state, region)
         if par == NONE:
             top = 3 * t + 2
         if c > lo + 1:
@@ -110,9 +116,21 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
     return top
 
 
-cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcept nogil:
+cdef inline void _mark_edge(Tri* T, int e, uint8_t flag, int32_t seg) noexcept nogil:
+    """Add `flag` to the existing edge e (both twins); an input segment (seg >= 0)
+    also gives it its id (a later duplicate of a segment wins)."""
+    T.eflag[e] |= flag
+    T.eflag[T.twin[e]] |= flag
+    if seg >= 0:
+        T.eseg[e] = seg
+        T.eseg[T.twin[e]] = seg
+
+
+cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int32_t seg,
+                       int* reached) noexcept nogil:
     """Insert the constrained edge from a toward b up to the first vertex on the segment
-    (b itself, or a vertex lying exactly on a-b); `reached` gets that vertex.
+    (b itself, or a vertex lying exactly on a-b); `reached` gets that vertex.  The new
+    edge gets `flag` and segment id `seg`; the cavity's other edges keep theirs.
 
     The walk along a->b collects the crossed triangles and the chains of vertices to the
     left and right.  A chain can visit a vertex twice: when every triangle around a
@@ -133,12 +151,12 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
     cdef int32_t* cext
     cdef int32_t* cnew
     cdef int32_t* cflag
+    cdef int32_t* cseg
     cdef uint8_t state
     cdef int32_t region
     cdef int e = find_edge(T, a, b)
     if e >= 0:
-        T.eflag[e] |= flag
-        T.eflag[T.twin[e]] |= flag
+        _mark_edge(T, e, flag, seg)
         reached[0] = b
         return 0
     res = _first_crossing(T, a, b, &h)
@@ -146,12 +164,11 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
         return res
     if res == 1:
         e = find_edge(T, a, h)
-        T.eflag[e] |= flag
-        T.eflag[T.twin[e]] |= flag
+        _mark_edge(T, e, flag, seg)
         reached[0] = h
         return 0
     while True:
-        if reserve_buf(T, 15 * m):
+        if reserve_buf(T, 17 * m):
             return ERR_NOMEM
         tris = T.buf
         lch = T.buf + m
@@ -184,6 +201,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
                 T.err_b = b
                 T.err_u = T.tv[h]
                 T.err_v = T.tv[nxt(h)]
+                T.err_seg = T.eseg[h]
                 return ERR_CROSSING
             g = T.twin[h]
             u = T.tv[g]            # left end of the crossed edge
@@ -236,6 +254,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
     # Mark the cavity, then find each chain edge's outer twin and flags.
     cnew = T.buf + 11 * m
     cflag = T.buf + 13 * m
+    cseg = T.buf + 15 * m
     for i in range(ntri):
         T.tstate[tris[i]] = T_FREE
     for i in range(nc):
@@ -243,6 +262,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
             continue                # the last vertex of a chain starts no chain edge
         e = corig[i]
         cflag[i] = T.eflag[e]
+        cseg[i] = T.eseg[e]
         g = T.twin[e]
         cext[i] = g if T.tstate[g // 3] != T_FREE else NONE
     nused = 0
@@ -266,6 +286,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
                     and cch[j] == cch[i + 1] and cch[j + 1] == cch[i]):
                 T.twin[cnew[i]] = cnew[j]
                 T.eflag[cnew[i]] = <uint8_t> cflag[i]
+                T.eseg[cnew[i]] = cseg[i]
                 break
         else:
             return ERR_INTERNAL
@@ -273,18 +294,21 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
     T.twin[topl] = topr
     T.eflag[topr] = flag
     T.eflag[topl] = flag
+    T.eseg[topr] = seg
+    T.eseg[topl] = seg
     T.last = topr // 3
     reached[0] = end
     return 0
 
 
-cdef int insert_segment(Tri* T, int a, int b, uint8_t flag) noexcept nogil:
+cdef int insert_segment(Tri* T, int a, int b, uint8_t flag, int32_t seg) noexcept nogil:
     """Make a-b an edge of the triangulation with `flag` set on it (on each piece, if
-    vertices lie exactly on a-b: the segment is then split there).  Returns 0, or 1 if
-    it was split, or a negative error code."""
+    vertices lie exactly on a-b: the segment is then split there), each piece carrying
+    segment id `seg` (-1 for a temporary constraint).  Returns 0, or 1 if it was split,
+    or a negative error code."""
     cdef int reached = NONE, res, guard = 0
     while a != b:
-        res = _insert_piece(T, a, b, flag, &reached)
+        res = _insert_piece(T, a, b, flag, seg, &reached)
         if res < 0:
             return res
         a = reached

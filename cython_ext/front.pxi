@@ -546,10 +546,10 @@ cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
         return ERR_INTERNAL
     if T.tv[prv(f)] != v:
         A.n_forced += 1
-        res = insert_segment(T, a, v, E_FIXED)
+        res = insert_segment(T, a, v, E_FIXED, -1)
         if res < 0:
             return res
-        res = insert_segment(T, v, b, E_FIXED)
+        res = insert_segment(T, v, b, E_FIXED, -1)
         if res < 0:
             return res
         f = find_edge(T, a, b)

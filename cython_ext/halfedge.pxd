@@ -18,6 +18,11 @@
 #   third vertex is GHOST (a symbolic point at infinity), so every walk and every
 #   rotation around a vertex stays inside the arrays.  The public API sees -1 there.
 # * eflag[e] holds E_SEGMENT / E_FIXED and is always written on both twins together.
+# * eseg[e] is the provenance of a constrained edge: the index of the input segment
+#   (the row given to insert_segment) it is a piece of, or -1 (not an input segment:
+#   a temporary constraint, or no constraint).  Like eflag it is written on both twins
+#   together and moves with the edge through every rewrite (set_tri), so pieces of a
+#   split segment and edges rebuilt by a retriangulation keep their segment's id.
 # * vhe[v] is one half-edge leaving v (tv[vhe[v]] == v).
 # * tstate[t] says whether a triangle is outside the domain, still unmeshed, or meshed;
 #   the frontal edge set C of the paper is implicit: a half-edge is a front edge exactly
@@ -66,6 +71,7 @@ cdef struct Tri:
     int32_t* tv         # 3 per triangle
     int32_t* twin       # 3 per triangle
     uint8_t* eflag      # 3 per triangle
+    int32_t* eseg       # 3 per triangle: input segment id, -1 if none
     uint8_t* tstate     # 1 per triangle
     int32_t* tregion    # 1 per triangle
     int32_t nt, nt_cap  # slots handed out so far / allocated (no slot is ever given
@@ -79,6 +85,7 @@ cdef struct Tri:
     int32_t buf_cap
     # where the last ERR_CROSSING came from: new edge (err_a, err_b) hit edge (err_u, err_v)
     int32_t err_a, err_b, err_u, err_v
+    int32_t err_seg     # ... which is a piece of input segment err_seg (-1: none)
 
 
 cdef inline int nxt(int e) noexcept nogil:

@@ -28,6 +28,7 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.tv = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.twin = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.eflag = <uint8_t*> malloc(3 * nt_cap * sizeof(uint8_t))
+    T.eseg = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.tstate = <uint8_t*> malloc(nt_cap * sizeof(uint8_t))
     T.tregion = <int32_t*> malloc(nt_cap * sizeof(int32_t))
     T.nt_cap = nt_cap
@@ -37,14 +38,14 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.buf = <int32_t*> malloc(T.buf_cap * sizeof(int32_t))
     T.last = NONE
     T.rng = WALK_RNG_SEED
-    if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
+    if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL or T.eseg == NULL
             or T.tstate == NULL or T.tregion == NULL or T.stack == NULL or T.buf == NULL):
         return ERR_NOMEM
     return 0
 
 
 cdef void tri_free(Tri* T) noexcept nogil:
-    free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag)
+    free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag); free(T.eseg)
     free(T.tstate); free(T.tregion); free(T.stack); free(T.buf)
     memset(T, 0, sizeof(Tri))
 
@@ -79,6 +80,7 @@ cdef int reserve_triangles(Tri* T, int n) noexcept nogil:
     if (_grow(<void**> &T.tv, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.twin, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.eflag, 3 * cap * sizeof(uint8_t)) or
+            _grow(<void**> &T.eseg, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.tstate, cap * sizeof(uint8_t)) or
             _grow(<void**> &T.tregion, cap * sizeof(int32_t))):
         return ERR_NOMEM
@@ -148,9 +150,11 @@ cdef inline bint blocking(Tri* T, int e) noexcept nogil:
 
 cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
                          int ta, int tb, int tc, uint8_t fa, uint8_t fb, uint8_t fc,
+                         int32_t sa, int32_t sb, int32_t sc,
                          uint8_t state, int32_t region) noexcept nogil:
     """Write triangle t = (a, b, c) with outer twins ta, tb, tc (NONE: set later by the
-    triangle on the other side) and edge flags fa, fb, fc; links the twins back."""
+    triangle on the other side), edge flags fa, fb, fc and segment ids sa, sb, sc;
+    links the twins back."""
     cdef int e = 3 * t
     T.tv[e] = a
     T.tv[e + 1] = b
@@ -161,15 +165,21 @@ cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
     T.eflag[e] = fa
     T.eflag[e + 1] = fb
     T.eflag[e + 2] = fc
+    T.eseg[e] = sa
+    T.eseg[e + 1] = sb
+    T.eseg[e + 2] = sc
     if ta >= 0:
         T.twin[ta] = e
         T.eflag[ta] = fa
+        T.eseg[ta] = sa
     if tb >= 0:
         T.twin[tb] = e + 1
         T.eflag[tb] = fb
+        T.eseg[tb] = sb
     if tc >= 0:
         T.twin[tc] = e + 2
         T.eflag[tc] = fc
+        T.eseg[tc] = sc
     if a >= 0:
         T.vhe[a] = e
     if b >= 0:
@@ -205,10 +215,11 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef int32_t ie1 = T.eseg[e1], ie2 = T.eseg[e2], if1 = T.eseg[f1], if2 = T.eseg[f2]
     cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
     cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
-    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, s0, r0)
-    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, s1, r1)
+    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, ie2, if1, -1, s0, r0)
+    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, if2, ie1, -1, s1, r1)
 
 
 cdef inline int in_circle_ext(Tri* T, int a, int b, int c, int d) noexcept nogil:
@@ -397,6 +408,7 @@ cdef int split_triangle(Tri* T, int t, int v) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e + 1], c = T.tv[e + 2]
     cdef int tw0 = T.twin[e], tw1 = T.twin[e + 1], tw2 = T.twin[e + 2]
     cdef uint8_t f0 = T.eflag[e], f1 = T.eflag[e + 1], f2 = T.eflag[e + 2]
+    cdef int32_t i0 = T.eseg[e], i1 = T.eseg[e + 1], i2 = T.eseg[e + 2]
     cdef uint8_t s = T.tstate[t]
     cdef int32_t r = T.tregion[t]
     cdef int t1 = new_triangle(T)
@@ -405,9 +417,9 @@ cdef int split_triangle(Tri* T, int t, int v) noexcept nogil:
     cdef int t2 = new_triangle(T)
     if t2 < 0:
         return ERR_NOMEM
-    set_tri(T, t, a, b, v, tw0, NONE, NONE, f0, 0, 0, s, r)
-    set_tri(T, t1, b, c, v, tw1, NONE, 3 * t + 1, f1, 0, 0, s, r)
-    set_tri(T, t2, c, a, v, tw2, 3 * t + 2, 3 * t1 + 1, f2, 0, 0, s, r)
+    set_tri(T, t, a, b, v, tw0, NONE, NONE, f0, 0, 0, i0, -1, -1, s, r)
+    set_tri(T, t1, b, c, v, tw1, NONE, 3 * t + 1, f1, 0, 0, i1, -1, -1, s, r)
+    set_tri(T, t2, c, a, v, tw2, 3 * t + 2, 3 * t1 + 1, f2, 0, 0, i2, -1, -1, s, r)
     if reserve_stack(T, 3):
         return ERR_NOMEM
     T.stack[0] = 3 * t
@@ -428,7 +440,9 @@ cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef int32_t ie1 = T.eseg[e1], ie2 = T.eseg[e2], if1 = T.eseg[f1], if2 = T.eseg[f2]
     cdef uint8_t g = T.eflag[e]
+    cdef int32_t ig = T.eseg[e]     # both halves stay pieces of the same segment
     cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
     cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
     cdef int t2 = new_triangle(T)
@@ -438,10 +452,10 @@ cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
     if t3 < 0:
         return ERR_NOMEM
     # (b, c, v) (c, a, v) on t0's side; (a, d, v) (d, b, v) on t1's side
-    set_tri(T, t0, b, c, v, te1, NONE, NONE, ge1, 0, g, s0, r0)
-    set_tri(T, t2, c, a, v, te2, NONE, 3 * t0 + 1, ge2, g, 0, s0, r0)
-    set_tri(T, t1, a, d, v, tf1, NONE, 3 * t2 + 1, gf1, 0, g, s1, r1)
-    set_tri(T, t3, d, b, v, tf2, 3 * t0 + 2, 3 * t1 + 1, gf2, g, 0, s1, r1)
+    set_tri(T, t0, b, c, v, te1, NONE, NONE, ge1, 0, g, ie1, -1, ig, s0, r0)
+    set_tri(T, t2, c, a, v, te2, NONE, 3 * t0 + 1, ge2, g, 0, ie2, ig, -1, s0, r0)
+    set_tri(T, t1, a, d, v, tf1, NONE, 3 * t2 + 1, gf1, 0, g, if1, -1, ig, s1, r1)
+    set_tri(T, t3, d, b, v, tf2, 3 * t0 + 2, 3 * t1 + 1, gf2, g, 0, if2, ig, -1, s1, r1)
     if reserve_stack(T, 4):
         return ERR_NOMEM
     T.stack[0] = 3 * t0
@@ -497,10 +511,12 @@ cdef int make_first_triangle(Tri* T, int a, int b, int c) noexcept nogil:
     if t < 0 or g0 < 0 or g1 < 0 or g2 < 0:
         return ERR_NOMEM
     # ghost gk sits across edge k of t: (b, a, G), (c, b, G), (a, c, G)
-    set_tri(T, t, a, b, c, NONE, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g0, b, a, GHOST, 3 * t, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g1, c, b, GHOST, 3 * t + 1, 3 * g0 + 2, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g2, a, c, GHOST, 3 * t + 2, 3 * g1 + 2, 3 * g0 + 1, 0, 0, 0, T_UNMESHED, 0)
+    set_tri(T, t, a, b, c, NONE, NONE, NONE, 0, 0, 0, -1, -1, -1, T_UNMESHED, 0)
+    set_tri(T, g0, b, a, GHOST, 3 * t, NONE, NONE, 0, 0, 0, -1, -1, -1, T_UNMESHED, 0)
+    set_tri(T, g1, c, b, GHOST, 3 * t + 1, 3 * g0 + 2, NONE, 0, 0, 0, -1, -1, -1,
+            T_UNMESHED, 0)
+    set_tri(T, g2, a, c, GHOST, 3 * t + 2, 3 * g1 + 2, 3 * g0 + 1, 0, 0, 0, -1, -1, -1,
+            T_UNMESHED, 0)
     T.last = t
     return 0
 
