@@ -13,8 +13,15 @@
 #   * Update_internal inserts R into cd(S(E)) and makes sure F and G are edges.
 # The heap only orders the work (Get_next_edge); it is not the definition of C, so
 # stale entries are simply skipped (lazy deletion).
-
+#
+# Uses: halfedge.pxd; aft.pxd (Aft, HeapItem); sizing.pxi (size_at); predicates.pxi;
+# triangulation.pxi (find_edge, insert_vertex_at, add_vertex, legalize_meshed,
+# reserve_stack, _grow); cdt.pxi (insert_segment).
+from halfedge cimport *
+from aft cimport Aft, HeapItem
 from libc.math cimport sqrt, floor, log2
+from libc.stdlib cimport malloc, free
+from libc.string cimport memset
 
 # Tuning constants of the compiled loop (each with the reason for its value).
 # Compute_new_candidate keeps |R - a| = |R - b| between these multiples of |E|: below
@@ -47,45 +54,6 @@ cdef extern from "Python.h":
     void PyErr_Fetch(PyObject** ptype, PyObject** pvalue, PyObject** ptraceback)
     void PyErr_Restore(PyObject* ptype, PyObject* pvalue, PyObject* ptraceback)
 
-cdef struct HeapItem:
-    double key
-    int64_t seq         # insertion count: ties and oldest-first
-    int32_t he          # the half-edge when pushed (it may move; org/dst identify it)
-    int32_t org
-    int32_t dst
-
-cdef struct Aft:
-    HeapItem* heap
-    int heap_n, heap_cap
-    int64_t seq
-    int order
-    SizeField size
-    int64_t max_triangles   # N_max of formula (4); < 0: none
-    double min_area         # A_min of formula (5); <= 0: none
-    double close_factor     # New_is_preferred takes S when |S - R| < close_factor * h
-    bint swaps              # Add_triangle keeps the meshed region a CDT by edge swaps
-    bint greedy             # New_is_preferred is always false
-    int64_t n_meshed        # N(T)
-    int64_t n_unmeshed      # triangles of the unmeshed CDT
-    int64_t n_new           # vertices created by Update_internal
-    int64_t n_steps         # passes through the while loop
-    int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
-    # Check_visible's output: crossed edges of the line of sight, and where R lies
-    int32_t* left
-    int32_t* right
-    int nleft, nright, lr_cap
-    int vis_loc, vis_where
-    # progress: meshed / total area, reported to a Python callable (a borrowed
-    # reference kept alive by the owning Triangulation) every few thousand steps
-    double area_total, area_meshed
-    void* progress
-    # the exception a signal handler raised (Ctrl-C's KeyboardInterrupt, a watchdog's
-    # own exception), held here until the def layer can raise it again
-    PyObject* exc_type
-    PyObject* exc_value
-    PyObject* exc_tb
-
-
 cdef int aft_init(Aft* A) noexcept nogil:
     memset(A, 0, sizeof(Aft))
     A.heap_cap = HEAP_INITIAL_CAP
@@ -106,7 +74,10 @@ cdef int aft_init(Aft* A) noexcept nogil:
 
 
 cdef void aft_free(Aft* A) noexcept nogil:
-    free(A.heap); free(A.left); free(A.right); free(A.size.h)
+    free(A.heap)
+    free(A.left)
+    free(A.right)
+    free(A.size.h)
     memset(A, 0, sizeof(Aft))
 
 
@@ -241,8 +212,9 @@ cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
 cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
     """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
     distance from a and b that the local size asks for (an equilateral triangle when
-    |E| equals the size), kept between SIDE_MIN_FACTOR |E| and SIDE_MAX_FACTOR |E| so that the triangle's shape
-    stays reasonable where the size changes faster than the front."""
+    |E| equals the size), kept between SIDE_MIN_FACTOR |E| and SIDE_MAX_FACTOR |E| so
+    that the triangle's shape stays reasonable where the size changes faster than the
+    front."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
@@ -407,7 +379,7 @@ cdef int check_visible(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
 
 
 cdef inline double _dist2_point_segment(const double* p, const double* a,
-                                       const double* b) noexcept nogil:
+                                        const double* b) noexcept nogil:
     cdef double ex = b[0] - a[0], ey = b[1] - a[1]
     cdef double px = p[0] - a[0], py = p[1] - a[1]
     cdef double L2 = ex * ex + ey * ey, s = 0.0

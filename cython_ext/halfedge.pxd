@@ -74,8 +74,9 @@ cdef struct Tri:
     int32_t* eseg       # 3 per triangle: input segment id, -1 if none
     uint8_t* tstate     # 1 per triangle
     int32_t* tregion    # 1 per triangle
-    int32_t nt, nt_cap  # slots handed out so far / allocated (no slot is ever given
-                        # back: every re-triangulation refills the slots it empties)
+    # slots handed out so far / allocated (no slot is ever given back: every
+    # re-triangulation refills the slots it empties)
+    int32_t nt, nt_cap
     int32_t last        # a live finite triangle where the next walk starts
     uint32_t rng        # xorshift state for the stochastic walk
     # scratch stacks, grown on demand, never shrunk
@@ -96,3 +97,19 @@ cdef inline int prv(int e) noexcept nogil:
 
 cdef inline int tri_of(int e) noexcept nogil:
     return e // 3
+
+cdef inline double* P(Tri* T, int v) noexcept nogil:
+    return &T.xy[2 * v]
+
+
+cdef inline bint is_ghost(Tri* T, int t) noexcept nogil:
+    return T.tv[3 * t] == GHOST or T.tv[3 * t + 1] == GHOST or T.tv[3 * t + 2] == GHOST
+
+
+cdef inline bint blocking(Tri* T, int e) noexcept nogil:
+    """A constrained edge: an input segment, a temporary constraint, or the boundary
+    between two triangles of different state (which makes every front edge constrained
+    for the walks, flips and retriangulations of the unmeshed CDT)."""
+    if T.eflag[e] & (E_SEGMENT | E_FIXED):
+        return True
+    return T.tstate[e // 3] != T.tstate[T.twin[e] // 3]

@@ -2,9 +2,16 @@
 #
 # Each pass moves every vertex that Basic_aft created (the input vertices never move)
 # to the best of a few candidate places, judged by the worst shape of its triangles,
-# when that keeps them all counter-clockwise (exact orient2d), and then restores the constrained Delaunay
-# property by Lawson flips over the whole mesh, so the result is still the CDT of its
-# vertices and the input edges.
+# when that keeps them all counter-clockwise (exact orient2d), and then restores the
+# constrained Delaunay property by Lawson flips over the whole mesh, so the result is
+# still the CDT of its
+# vertices and the input edges.  Flips never touch constrained edges, so every input
+# segment keeps its pieces and their ids (eseg).
+#
+# Uses: halfedge.pxd; aft.pxd (Aft); predicates.pxi (orient2d); triangulation.pxi
+# (legalize_meshed, reserve_stack); front.pxi (check_signals).
+from halfedge cimport *
+from aft cimport Aft
 
 # A vertex whose triangles all have a shape above this is left alone: nearly all are,
 # after Basic_aft, and the skip saves most of the work of a pass.

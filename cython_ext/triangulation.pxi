@@ -1,6 +1,9 @@
 # Half-edge triangulation: storage, flips, point location and point insertion.
 # Conventions: halfedge.pxd.  Geometry is only ever read through the predicates.
-
+#
+# Uses: halfedge.pxd (Tri, enums, nxt/prv, P, is_ghost, blocking); predicates.pxi
+# (orient2d, incircle).
+from halfedge cimport *
 from libc.stdlib cimport malloc, realloc, free
 from libc.string cimport memset
 
@@ -38,15 +41,24 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.buf = <int32_t*> malloc(T.buf_cap * sizeof(int32_t))
     T.last = NONE
     T.rng = WALK_RNG_SEED
-    if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL or T.eseg == NULL
-            or T.tstate == NULL or T.tregion == NULL or T.stack == NULL or T.buf == NULL):
+    if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
+            or T.eseg == NULL or T.tstate == NULL or T.tregion == NULL or T.stack == NULL
+            or T.buf == NULL):
         return ERR_NOMEM
     return 0
 
 
 cdef void tri_free(Tri* T) noexcept nogil:
-    free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag); free(T.eseg)
-    free(T.tstate); free(T.tregion); free(T.stack); free(T.buf)
+    free(T.xy)
+    free(T.vhe)
+    free(T.tv)
+    free(T.twin)
+    free(T.eflag)
+    free(T.eseg)
+    free(T.tstate)
+    free(T.tregion)
+    free(T.stack)
+    free(T.buf)
     memset(T, 0, sizeof(Tri))
 
 
@@ -129,23 +141,6 @@ cdef int new_triangle(Tri* T) noexcept nogil:
         return ERR_NOMEM
     T.nt += 1
     return T.nt - 1
-
-
-cdef inline double* P(Tri* T, int v) noexcept nogil:
-    return &T.xy[2 * v]
-
-
-cdef inline bint is_ghost(Tri* T, int t) noexcept nogil:
-    return T.tv[3 * t] == GHOST or T.tv[3 * t + 1] == GHOST or T.tv[3 * t + 2] == GHOST
-
-
-cdef inline bint blocking(Tri* T, int e) noexcept nogil:
-    """A constrained edge: an input segment, a temporary constraint, or the boundary
-    between two triangles of different state (which makes every front edge constrained
-    for the walks, flips and retriangulations of the unmeshed CDT)."""
-    if T.eflag[e] & (E_SEGMENT | E_FIXED):
-        return True
-    return T.tstate[e // 3] != T.tstate[T.twin[e] // 3]
 
 
 cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
@@ -535,3 +530,37 @@ cdef int find_edge(Tri* T, int a, int b) noexcept nogil:
         guard += 1
         if e == e0 or guard > T.nt * 3 + 3:
             return NONE
+
+
+cdef int insert_points(Tri* T, const int32_t* order, int m, int32_t* merged) noexcept nogil:
+    """Start the triangulation and insert the vertices order[0..m) in that order (a
+    spatially coherent order keeps the walks short).  merged[v] gets the vertex at
+    exactly the same place that v was merged into (it is left as is for the inserted
+    vertices).  Returns 0, ERR_COLLINEAR when all the points lie on one line, or an
+    error."""
+    cdef int i, v, first, second = NONE, third = NONE, res, pos
+    # a non-degenerate first triangle: the first point, the next distinct one, and the
+    # next one off their line
+    first = order[0]
+    for i in range(1, m):
+        v = order[i]
+        if T.xy[2 * v] != T.xy[2 * first] or T.xy[2 * v + 1] != T.xy[2 * first + 1]:
+            if second == NONE:
+                second = v
+            elif orient2d(P(T, first), P(T, second), P(T, v)) != 0:
+                third = v
+                break
+    if third == NONE:
+        return ERR_COLLINEAR
+    res = make_first_triangle(T, first, second, third)
+    if res < 0:
+        return res
+    for i in range(m):
+        v = order[i]
+        if v == first or v == second or v == third:
+            continue
+        pos = insert_vertex(T, v, NONE)
+        if pos < 0:
+            return pos
+        merged[v] = pos
+    return 0
