@@ -9,6 +9,7 @@ hold the ``nogil`` kernels:
 * triangulation.pxi  half-edge storage, flips, point location, point insertion
 * cdt.pxi            constrained edges (Cline & Renka), with segment provenance
 * domain.pxi         flood fills: carving, regions, the pieces segments separate
+* export.pxi         the domain's triangles as compact arrays
 * sizing.pxi         the compiled size field (background grid), gradation limit
 * ordering.pxi       Hilbert curve keys for the insertion order
 * front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
