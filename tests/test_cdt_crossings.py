@@ -10,12 +10,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import triangle
+from test_cdt import assert_exact_cdt, exact_report
 
 import aftmesh
 from aftmesh import _kernel
 from aftmesh.errors import CrossingSegmentsError, InvalidOptionError
-
-from test_cdt import assert_exact_cdt, exact_report
 
 
 def _within_span(p, a, b):
@@ -138,8 +137,8 @@ def random_crossing_case(rng, n_segments):
 
 def _triangle_p(V, S):
     out = triangle.triangulate(
-        dict(vertices=V, segments=S.astype(np.int32),
-             segment_markers=(np.arange(len(S)) + 1).astype(np.int32).reshape(-1, 1)), "p")
+        {"vertices": V, "segments": S.astype(np.int32),
+             "segment_markers": (np.arange(len(S)) + 1).astype(np.int32).reshape(-1, 1)}, "p")
     return out
 
 
