@@ -7,15 +7,25 @@ hold the ``nogil`` kernels:
 
 * predicates.pxi     exact orient2d / incircle: filter, adaptive stage, exact fallback
 * triangulation.pxi  half-edge storage, flips, point location, point insertion
-* cdt.pxi            constrained edges (Cline & Renka) and flood fills
-* sizing.pxi         the compiled size field (background grid)
+* cdt.pxi            constrained edges (Cline & Renka), with segment provenance
+* domain.pxi         flood fills: carving, regions, the pieces segments separate
+* export.pxi         the domain's triangles as compact arrays
+* sizing.pxi         the compiled size field (background grid), gradation limit
+* ordering.pxi       Hilbert curve keys for the insertion order
 * front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
+* smoothing.pxi      smoothing after the front closes, with Delaunay flips
+
+and the declarations they share: halfedge.pxd (the triangulation struct, its
+convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
+(the state of the Basic_aft loop).
 
 Every kernel routine returns a status code (0 or a count on success, a negative ERR_*
 from halfedge.pxd on failure); the methods here turn codes into exceptions.
 """
 from halfedge cimport *
-from cpython.ref cimport Py_XDECREF
+from aft cimport Aft
+from cpython.ref cimport Py_XDECREF, PyObject
+from libc.stdlib cimport malloc, free
 
 import numpy as np
 
@@ -28,7 +38,10 @@ DEBUG = bool(AFTMESH_DEBUG_BUILD)
 include "predicates.pxi"
 include "triangulation.pxi"
 include "cdt.pxi"
+include "domain.pxi"
+include "export.pxi"
 include "sizing.pxi"
+include "ordering.pxi"
 include "front.pxi"
 include "smoothing.pxi"
 
@@ -39,12 +52,15 @@ class KernelError(RuntimeError):
 
 class CrossingError(ValueError):
     """A constrained edge would cross another one; ``edge`` and ``blocker`` give the
-    vertex pairs (kernel vertex indices) of the new edge and of the edge it hit."""
+    vertex pairs (kernel vertex indices) of the new edge and of the edge it hit, and
+    ``blocker_segment`` the id of the input segment the hit edge is a piece of (-1:
+    not an input segment)."""
 
-    def __init__(self, msg, edge, blocker):
+    def __init__(self, msg, edge, blocker, blocker_segment=-1):
         super().__init__(msg)
         self.edge = edge
         self.blocker = blocker
+        self.blocker_segment = blocker_segment
 
 
 class CollinearError(ValueError):
@@ -73,7 +89,7 @@ cdef object _raise_for(Tri* T, int code):
     if code == ERR_CROSSING:
         raise CrossingError(
             f"edge ({T.err_a}, {T.err_b}) crosses constrained edge ({T.err_u}, {T.err_v})",
-            (T.err_a, T.err_b), (T.err_u, T.err_v))
+            (T.err_a, T.err_b), (T.err_u, T.err_v), T.err_seg)
     if code == ERR_COLLINEAR:
         raise CollinearError("all input points are collinear: there is no triangle")
     if code == ERR_INTERRUPTED:
@@ -81,19 +97,31 @@ cdef object _raise_for(Tri* T, int code):
     raise KernelError(f"aftmesh kernel: internal invariant broken (code {code})")
 
 
-cdef double _twice_area(Tri* T, int t):
-    cdef double* a = P(T, T.tv[3 * t])
-    cdef double* b = P(T, T.tv[3 * t + 1])
-    cdef double* c = P(T, T.tv[3 * t + 2])
-    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+# Raw data pointers of C-contiguous numpy arrays for the kernel routines (NULL when
+# empty: the routines then never read them).
+cdef int32_t* _i32(arr) except? NULL:
+    cdef int32_t[::1] v = arr.reshape(-1)
+    return &v[0] if v.shape[0] else NULL
 
 
-cdef tuple _centroid(Tri* T, int t):
-    cdef double* a = P(T, T.tv[3 * t])
-    cdef double* b = P(T, T.tv[3 * t + 1])
-    cdef double* c = P(T, T.tv[3 * t + 2])
-    return ((a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0)
+cdef uint8_t* _u8(arr) except? NULL:
+    cdef uint8_t[::1] v = arr.reshape(-1)
+    return &v[0] if v.shape[0] else NULL
 
+
+cdef double* _f64(arr) except? NULL:
+    cdef double[::1] v = arr.reshape(-1)
+    return &v[0] if v.shape[0] else NULL
+
+
+# The named enums of halfedge.pxd, for src/aftmesh/_states.py (tests/test_states.py
+# checks that the IntEnums there hold these values).
+TRIANGLE_STATE_VALUES = dict(FREE=T_FREE, EXTERIOR=T_EXTERIOR, UNMESHED=T_UNMESHED,
+                             MESHED=T_MESHED)
+ORDER_VALUES = dict(SHORTEST=ORDER_SHORTEST, LONGEST=ORDER_LONGEST, OLDEST=ORDER_OLDEST)
+LOCATION_VALUES = dict(IN_TRIANGLE=LOC_IN_TRIANGLE, ON_EDGE=LOC_ON_EDGE,
+                       ON_VERTEX=LOC_ON_VERTEX, OUTSIDE=LOC_OUTSIDE)
+EDGE_FLAG_VALUES = dict(SEGMENT=E_SEGMENT, FIXED=E_FIXED)
 
 # Coordinates (besides 0) for which orient2d and incircle are exact (predicates.pxi).
 EXACT_COORDINATE_RANGE = (EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
@@ -138,52 +166,40 @@ cdef class Triangulation:
         """Insert the vertices in `order` (a spatially coherent order makes the walks
         short).  Returns an int32 array `merged`: merged[v] == v for inserted vertices,
         or the index of the earlier vertex at exactly the same place."""
-        cdef int n = self.T.nv, i, k, v, first, second = NONE, third = NONE, res = 0, pos
+        cdef int n = self.T.nv, res = 0
         cdef int m = order.shape[0]
         merged_arr = np.arange(n, dtype=np.int32)
-        cdef int32_t[::1] merged = merged_arr
-        cdef Tri* T = &self.T
         if m == 0:
             return merged_arr
+        order_np = np.asarray(order)
+        if order_np.min() < 0 or order_np.max() >= n:
+            raise ValueError(f"order holds a vertex outside 0..{n - 1}")
+        cdef int32_t* merged = _i32(merged_arr)
         with nogil:
-            # pick a non-degenerate first triangle: the first point, the next distinct
-            # one, and the next one off their line
-            first = order[0]
-            for i in range(1, m):
-                v = order[i]
-                if T.xy[2 * v] != T.xy[2 * first] or T.xy[2 * v + 1] != T.xy[2 * first + 1]:
-                    if second == NONE:
-                        second = v
-                    elif orient2d(P(T, first), P(T, second), P(T, v)) != 0:
-                        third = v
-                        break
-            if third == NONE:
-                res = ERR_COLLINEAR
-            else:
-                res = make_first_triangle(T, first, second, third)
-            if res == 0:
-                for i in range(m):
-                    v = order[i]
-                    if v == first or v == second or v == third:
-                        continue
-                    pos = insert_vertex(T, v, NONE)
-                    if pos < 0:
-                        res = pos
-                        break
-                    merged[v] = pos
-        _raise_for(T, res)
+            res = insert_points(&self.T, &order[0], m, merged)
+        _raise_for(&self.T, res)
         return merged_arr
 
-    def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT):
-        """Insert constrained edges (pairs of vertex indices).  Returns how many of
-        them ran exactly through other vertices and were split there.  On a crossing,
-        raises CrossingError with `index` set to the row that failed."""
-        cdef int i, res = 0, failed = -1, through = 0
+    def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
+                        int first_id=0):
+        """Insert constrained edges (pairs of vertex indices).  With flag E_SEGMENT,
+        row i is input segment first_id + i: every piece of it carries that id
+        (arrays()["segment_ids"]); other flags carry -1.  Returns how many of them ran
+        exactly through other vertices and were split there.  On a crossing, raises
+        CrossingError with `index` set to the row that failed."""
+        cdef int i, k, res = 0, failed = -1, through = 0
+        cdef bint is_input = (flag & E_SEGMENT) != 0
         cdef int m = segments.shape[0]
         cdef Tri* T = &self.T
+        for i in range(m):
+            for k in range(2):
+                if not 0 <= segments[i, k] < T.nv or T.vhe[segments[i, k]] < 0:
+                    raise ValueError(f"segments[{i}] = {list(segments[i])} refers to a vertex "
+                                     "that is not in the triangulation")
         with nogil:
             for i in range(m):
-                res = insert_segment(T, segments[i, 0], segments[i, 1], <uint8_t> flag)
+                res = insert_segment(T, segments[i, 0], segments[i, 1], <uint8_t> flag,
+                                     first_id + i if is_input else -1)
                 if res < 0:
                     failed = i
                     break
@@ -198,56 +214,21 @@ cdef class Triangulation:
     def carve(self, const double[:, ::1] holes, bint from_hull=True):
         """Mark as exterior the triangles reachable without crossing a segment from the
         ghost triangles (if `from_hull`) and from each hole point."""
-        cdef Tri* T = &self.T
-        cdef int t, n = 0, res = 0, i, where = NONE, loc
+        cdef int res, n = holes.shape[0]
         with nogil:
-            if reserve_stack(T, T.nt):
-                res = ERR_NOMEM
-            else:
-                for t in range(T.nt):
-                    if T.tstate[t] != T_FREE and is_ghost(T, t):
-                        if from_hull:
-                            T.stack[n] = t
-                            n += 1
-                        else:
-                            T.tstate[t] = T_EXTERIOR
-                res = flood(T, n, T_UNMESHED, T_EXTERIOR, 0, False)
-            for i in range(holes.shape[0]):
-                if res < 0:
-                    break
-                loc = locate(T, &holes[i, 0], NONE, &where)
-                if loc < 0:
-                    res = loc
-                elif _seed_triangle(T, loc, where) >= 0:
-                    T.stack[0] = _seed_triangle(T, loc, where)
-                    res = flood(T, 1, T_UNMESHED, T_EXTERIOR, 0, False)
-        _raise_for(T, res)
+            res = carve_domain(&self.T, &holes[0, 0] if n else NULL, n, from_hull)
+        _raise_for(&self.T, res)
 
     def assign_regions(self, const double[:, ::1] seeds, const int32_t[::1] ids):
         """Give region id ids[k] to every domain triangle reachable from seeds[k]
         without crossing a segment (later seeds win)."""
-        cdef Tri* T = &self.T
-        cdef int i, res = 0, where = NONE, loc, t, k, sp
+        cdef int res, n = seeds.shape[0]
+        if ids.shape[0] != n:
+            raise ValueError("seeds and ids differ in length")
         with nogil:
-            for i in range(seeds.shape[0]):
-                loc = locate(T, &seeds[i, 0], NONE, &where)
-                if loc < 0:
-                    res = loc
-                    break
-                t = _seed_triangle(T, loc, where)
-                if t < 0:
-                    continue
-                if T.tstate[t] != T_UNMESHED:
-                    continue
-                # flood by a temporary state so that region boundaries need no marker
-                T.stack[0] = t
-                res = flood(T, 1, T_UNMESHED, T_MESHED, ids[i], True)
-                if res < 0:
-                    break
-                for t in range(T.nt):
-                    if T.tstate[t] == T_MESHED:
-                        T.tstate[t] = T_UNMESHED
-        _raise_for(T, res)
+            res = assign_regions(&self.T, &seeds[0, 0] if n else NULL,
+                                 &ids[0] if n else NULL, n)
+        _raise_for(&self.T, res)
 
     def components(self):
         """Split the domain triangles into the pieces that segments separate.
@@ -259,64 +240,42 @@ cdef class Triangulation:
         that triangle's corners (the rounded centroid of a triangle an ulp or two wide
         may not be inside it: the caller checks)."""
         cdef Tri* T = &self.T
-        cdef int t, k, e, u, sp, nc = 0, best_t = 0
-        cdef double area
+        cdef int nc, c, k
+        cdef double* q
         comp_arr = np.full(T.nt, -1, dtype=np.int32)
+        best_arr = np.zeros(max(T.nt, 1), dtype=np.int32)
         cdef int32_t[::1] comp = comp_arr
-        best = []
-        corners = []
-        if reserve_stack(T, T.nt + 1):
-            raise MemoryError()
-        for t in range(T.nt):
-            if T.tstate[t] != T_UNMESHED or comp[t] >= 0:
-                continue
-            best_area = -1.0
-            best_xy = (0.0, 0.0)
-            comp[t] = nc
-            T.stack[0] = t
-            sp = 1
-            while sp > 0:
-                sp -= 1
-                u = T.stack[sp]
-                area = _twice_area(T, u)
-                if area > best_area:
-                    best_area = area
-                    best_xy = _centroid(T, u)
-                    best_t = u
-                for k in range(3):
-                    e = 3 * u + k
-                    if T.eflag[e] & E_SEGMENT:
-                        continue
-                    e = T.twin[e] // 3
-                    if T.tstate[e] == T_UNMESHED and comp[e] < 0:
-                        comp[e] = nc
-                        T.stack[sp] = e
-                        sp += 1
-            best.append(best_xy)
-            corners.append([(P(T, T.tv[3 * best_t + k])[0], P(T, T.tv[3 * best_t + k])[1])
-                            for k in range(3)])
-            nc += 1
-        return (comp_arr, np.array(best, dtype=np.float64).reshape(-1, 2),
-                np.array(corners, dtype=np.float64).reshape(-1, 3, 2))
+        cdef int32_t[::1] best = best_arr
+        with nogil:
+            nc = domain_components(T, &comp[0] if T.nt else NULL, &best[0])
+        _raise_for(T, nc)
+        corners_arr = np.empty((nc, 3, 2), dtype=np.float64)
+        probe_arr = np.empty((nc, 2), dtype=np.float64)
+        cdef double[:, :, ::1] corners = corners_arr
+        cdef double[:, ::1] probe = probe_arr
+        for c in range(nc):
+            for k in range(3):
+                q = P(T, T.tv[3 * best[c] + k])
+                corners[c, k, 0] = q[0]
+                corners[c, k, 1] = q[1]
+            probe[c, 0] = (corners[c, 0, 0] + corners[c, 1, 0] + corners[c, 2, 0]) / 3.0
+            probe[c, 1] = (corners[c, 0, 1] + corners[c, 1, 1] + corners[c, 2, 1]) / 3.0
+        return comp_arr, probe_arr, corners_arr
 
     def set_regions(self, const int32_t[::1] comp, const int32_t[::1] region_of_comp):
         """Give every domain triangle the region of its piece (see components());
         pieces whose region is -1 (holes, outside) become exterior."""
-        cdef Tri* T = &self.T
-        cdef int t, r
-        for t in range(min(T.nt, comp.shape[0])):
-            if comp[t] < 0 or T.tstate[t] != T_UNMESHED:
-                continue
-            r = region_of_comp[comp[t]]
-            if r < 0:
-                T.tstate[t] = T_EXTERIOR
-            else:
-                T.tregion[t] = r
+        cdef int n = comp.shape[0]
+        if n and region_of_comp.shape[0] <= np.asarray(comp).max():
+            raise ValueError("region_of_comp has no entry for some piece")
+        set_regions(&self.T, &comp[0] if n else NULL, n,
+                    &region_of_comp[0] if region_of_comp.shape[0] else NULL)
 
     def state_at(self, double x, double y):
-        """State of the triangle holding (x, y): 1 exterior, 2 unmeshed, 3 meshed; 1
-        outside the hull; 0 when the point lies on a segment or on a vertex that a
-        segment ends at (it then belongs to no single region)."""
+        """State (T_EXTERIOR, T_UNMESHED, T_MESHED: aftmesh._states.TriangleState) of
+        the triangle holding (x, y); T_EXTERIOR outside the hull; None when the point
+        lies on a segment or on a vertex that a segment ends at (it then belongs to no
+        single region)."""
         cdef double p[2]
         cdef int where = NONE, loc
         p[0] = x
@@ -327,11 +286,11 @@ cdef class Triangulation:
             return self.T.tstate[where]
         if loc == LOC_ON_EDGE:
             if self.T.eflag[where] & E_SEGMENT:
-                return 0
+                return None
             return self.T.tstate[where // 3]
         if loc == LOC_ON_VERTEX:
             if _vertex_on_segment(&self.T, where):
-                return 0
+                return None
             return self.T.tstate[self.T.vhe[where] // 3]
         return T_EXTERIOR
 
@@ -368,6 +327,11 @@ cdef class Triangulation:
                     problems.append(f"half-edge {e}: twin {f} has other end points")
                 if T.eflag[f] != T.eflag[e]:
                     problems.append(f"half-edge {e}: flags differ from twin")
+                if T.eseg[f] != T.eseg[e]:
+                    problems.append(f"half-edge {e}: segment id differs from twin")
+                if (T.eseg[e] >= 0) != ((T.eflag[e] & E_SEGMENT) != 0):
+                    problems.append(f"half-edge {e}: segment id {T.eseg[e]} with flags "
+                                    f"{T.eflag[e]}")
             if not is_ghost(T, t):
                 if orient2d(P(T, T.tv[3 * t]), P(T, T.tv[3 * t + 1]), P(T, T.tv[3 * t + 2])) <= 0:
                     problems.append(f"triangle {t}: not counter-clockwise")
@@ -382,61 +346,33 @@ cdef class Triangulation:
 
         Returns a dict: points (n, 2), triangles (t, 3) counter-clockwise, neighbors
         (t, 3) with neighbors[i, k] across the edge opposite vertex k (-1: none),
-        segments (s, 2) (constrained edges of the domain, each once), regions (t,),
-        vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
+        segments (s, 2) (constrained edges of the domain, each once), segment_ids (s,)
+        the input segment each is a piece of (see insert_segments; -1: none), regions
+        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
         cdef Tri* T = &self.T
-        cdef int t, k, e, ntri = 0, nvo = 0, u
+        cdef int ntri, nvo, ns
         keep_arr = np.zeros(T.nt, dtype=np.uint8)
-        cdef uint8_t[::1] keep = keep_arr
-        for t in range(T.nt):
-            if T.tstate[t] == T_UNMESHED or T.tstate[t] == T_MESHED or (
-                    include_exterior and T.tstate[t] == T_EXTERIOR and not is_ghost(T, t)):
-                keep[t] = 1
-                ntri += 1
         tri_index_arr = np.full(T.nt, -1, dtype=np.int32)
-        cdef int32_t[::1] tri_index = tri_index_arr
         vmap_arr = np.full(T.nv, -1, dtype=np.int32)
-        cdef int32_t[::1] vmap = vmap_arr
+        cdef uint8_t* keep = _u8(keep_arr)
+        cdef int32_t* tri_index = _i32(tri_index_arr)
+        cdef int32_t* vmap = _i32(vmap_arr)
+        ntri = mark_output(T, include_exterior, keep)
         tris_arr = np.empty((ntri, 3), dtype=np.int32)
-        cdef int32_t[:, ::1] tris = tris_arr
         regions_arr = np.empty(ntri, dtype=np.int32)
-        cdef int32_t[::1] regions = regions_arr
-        ntri = 0
-        for t in range(T.nt):
-            if keep[t]:
-                tri_index[t] = ntri
-                regions[ntri] = T.tregion[t]
-                for k in range(3):
-                    u = T.tv[3 * t + k]
-                    if vmap[u] < 0:
-                        vmap[u] = nvo
-                        nvo += 1
-                    tris[ntri, k] = vmap[u]
-                ntri += 1
+        nvo = number_output(T, keep, tri_index, vmap, _i32(tris_arr), _i32(regions_arr))
         points_arr = np.empty((nvo, 2), dtype=np.float64)
-        cdef double[:, ::1] pts = points_arr
-        for u in range(T.nv):
-            if vmap[u] >= 0:
-                pts[vmap[u], 0] = T.xy[2 * u]
-                pts[vmap[u], 1] = T.xy[2 * u + 1]
+        output_points(T, vmap, _f64(points_arr))
+        ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
         nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
-        cdef int32_t[:, ::1] nbr = nbr_arr
-        segs = []
-        for t in range(T.nt):
-            if keep[t]:
-                for k in range(3):
-                    e = 3 * t + k
-                    # the edge opposite vertex k is half-edge 3t + (k+1) % 3
-                    u = T.twin[3 * t + (k + 1) % 3] // 3
-                    if keep[u]:
-                        nbr[tri_index[t], k] = tri_index[u]
-                    if T.eflag[e] & E_SEGMENT:
-                        u = T.twin[e] // 3
-                        if not keep[u] or u > t:
-                            segs.append((vmap[T.tv[e]], vmap[T.tv[nxt(e)]]))
-        seg_arr = np.array(segs, dtype=np.int32).reshape(-1, 2)
+        seg_arr = np.empty((ns, 2), dtype=np.int32)
+        seg_ids = np.empty(ns, dtype=np.int32)
+        if ntri:
+            output_edges(T, keep, tri_index, vmap, _i32(nbr_arr), _i32(seg_arr),
+                         _i32(seg_ids))
         return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
-                    segments=seg_arr, regions=regions_arr, vertex_map=vmap_arr)
+                    segments=seg_arr, segment_ids=seg_ids,
+                    regions=regions_arr, vertex_map=vmap_arr)
 
     def raw(self):
         """Copies of the raw kernel arrays (for tests and debugging)."""
@@ -447,10 +383,10 @@ cdef class Triangulation:
             tv=np.asarray(<int32_t[:n3]> T.tv).copy(),
             twin=np.asarray(<int32_t[:n3]> T.twin).copy(),
             eflag=np.asarray(<uint8_t[:n3]> T.eflag).copy(),
+            eseg=np.asarray(<int32_t[:n3]> T.eseg).copy(),
             tstate=np.asarray(<uint8_t[:T.nt]> T.tstate).copy(),
             tregion=np.asarray(<int32_t[:T.nt]> T.tregion).copy(),
             vhe=np.asarray(<int32_t[:T.nv]> T.vhe).copy())
-
 
     # ------------------------------------------------------------ Basic_aft
 
@@ -655,43 +591,15 @@ cdef class Triangulation:
 def hilbert_keys(const double[:, ::1] xy, int bits=16):
     """Index of each point along a Hilbert curve of 2**bits cells a side laid over the
     points' bounding square (int64)."""
-    cdef Py_ssize_t n = xy.shape[0], i
+    cdef Py_ssize_t n = xy.shape[0]
     out_arr = np.zeros(n, dtype=np.int64)
     cdef int64_t[::1] out = out_arr
-    if n == 0:
-        return out_arr
-    cdef double lox = xy[0, 0], loy = xy[0, 1], hix = xy[0, 0], hiy = xy[0, 1], span, scale
-    cdef int64_t side = (<int64_t> 1 << bits) - 1, x, y, s, d, rx, ry, tmp
-    with nogil:
-        for i in range(n):
-            lox = min(lox, xy[i, 0]); hix = max(hix, xy[i, 0])
-            loy = min(loy, xy[i, 1]); hiy = max(hiy, xy[i, 1])
-        span = max(hix - lox, hiy - loy)
-        if span > 0:
-            scale = side / span
-            for i in range(n):
-                x = <int64_t> ((xy[i, 0] - lox) * scale)
-                y = <int64_t> ((xy[i, 1] - loy) * scale)
-                x = min(max(x, 0), side)
-                y = min(max(y, 0), side)
-                d = 0
-                s = <int64_t> 1 << (bits - 1)
-                while s > 0:
-                    rx = 1 if (x & s) else 0
-                    ry = 1 if (y & s) else 0
-                    d += s * s * ((3 * rx) ^ ry)
-                    # rotate the quadrant so the curve inside has the standard orientation
-                    if ry == 0:
-                        if rx == 1:
-                            x = side - x
-                            y = side - y
-                        tmp = x
-                        x = y
-                        y = tmp
-                    s >>= 1
-                out[i] = d
+    if not 1 <= bits <= 31:
+        raise ValueError(f"bits must be in 1..31, got {bits}")
+    if n:
+        with nogil:
+            hilbert_keys_into(&xy[0, 0], n, bits, &out[0])
     return out_arr
-
 
 
 def orient2d_many(const double[:, ::1] points, const int32_t[:, ::1] tri):
@@ -721,31 +629,6 @@ def limit_gradation_grid(double[:, ::1] h, double dx, double dy, double rate, in
     """In place: lower h so that h[p] <= h[q] + rate * |p - q| between grid neighbours
     (8-neighbour raster sweeps, forward then backward, `rounds` times), i.e. the size
     grows by at most `rate` per unit of length along any path of grid nodes."""
-    cdef Py_ssize_t ny = h.shape[0], nx = h.shape[1], i, j, r
-    cdef double cx = rate * dx, cy = rate * dy, cd = rate * sqrt(dx * dx + dy * dy), v
-    with nogil:
-        for r in range(rounds):
-            for j in range(ny):
-                for i in range(nx):
-                    v = h[j, i]
-                    if i > 0:
-                        v = min(v, h[j, i - 1] + cx)
-                    if j > 0:
-                        v = min(v, h[j - 1, i] + cy)
-                        if i > 0:
-                            v = min(v, h[j - 1, i - 1] + cd)
-                        if i < nx - 1:
-                            v = min(v, h[j - 1, i + 1] + cd)
-                    h[j, i] = v
-            for j in range(ny - 1, -1, -1):
-                for i in range(nx - 1, -1, -1):
-                    v = h[j, i]
-                    if i < nx - 1:
-                        v = min(v, h[j, i + 1] + cx)
-                    if j < ny - 1:
-                        v = min(v, h[j + 1, i] + cy)
-                        if i < nx - 1:
-                            v = min(v, h[j + 1, i + 1] + cd)
-                        if i > 0:
-                            v = min(v, h[j + 1, i - 1] + cd)
-                    h[j, i] = v
+    if h.shape[0] and h.shape[1]:
+        with nogil:
+            limit_gradation(&h[0, 0], h.shape[1], h.shape[0], dx, dy, rate, rounds)

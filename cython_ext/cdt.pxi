@@ -1,10 +1,20 @@
-# Constrained edges (Cline & Renka) and flood fills over the triangulation.
+# Constrained edges by Cline & Renka's retriangulation (flood fills: domain.pxi).
 #
 # A new constrained edge a-b is inserted by removing exactly the triangles whose
 # interiors it crosses and re-triangulating the two pseudo-polygons on either side of it
 # as constrained Delaunay triangulations (Cline & Renka's Theorem 1: the rest of the
 # triangulation is untouched and stays a CDT).  The same routine serves the CDT of the
-# input domain and Update_internal's edges F and G.
+# input domain and Update_internal's edges F and G.  Each new constrained edge carries
+# the id of the input segment it is a piece of (eseg, see halfedge.pxd).
+#
+# Uses: halfedge.pxd; predicates.pxi (orient2d, incircle); triangulation.pxi
+# (set_tri, find_edge, reserve_stack, reserve_buf).
+from halfedge cimport *
+
+cdef enum:
+    # _insert_piece's first guess at the crossed triangles of one piece; it restarts
+    # with 4 times more when the walk outgrows it (nothing is modified before that)
+    CAVITY_INITIAL_CAP = 64
 
 
 cdef inline bint _on_ray(Tri* T, int a, int b, int x) noexcept nogil:
@@ -58,6 +68,7 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
     """
     cdef int top = NONE, sp = 0, lo, hi, par, c, j, t, tw0, tw1
     cdef uint8_t f0, f1
+    cdef int32_t i0, i1
     if reserve_stack(T, 3 * (n + 2)):
         return ERR_NOMEM
     T.stack[0] = 0
@@ -77,19 +88,24 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
         nused[0] += 1
         tw0 = NONE
         f0 = 0
+        i0 = -1
         if c == lo + 1:
             newhe[lo] = 3 * t
             tw0 = ext[lo]
             if tw0 >= 0:
                 f0 = T.eflag[tw0]
+                i0 = T.eseg[tw0]
         tw1 = NONE
         f1 = 0
+        i1 = -1
         if hi == c + 1:
             newhe[c] = 3 * t + 1
             tw1 = ext[c]
             if tw1 >= 0:
                 f1 = T.eflag[tw1]
-        set_tri(T, t, chain[lo], chain[c], chain[hi], tw0, tw1, par, f0, f1, 0, state, region)
+                i1 = T.eseg[tw1]
+        set_tri(T, t, chain[lo], chain[c], chain[hi], tw0, tw1, par, f0, f1, 0, i0, i1, -1,
+                state, region)
         if par == NONE:
             top = 3 * t + 2
         if c > lo + 1:
@@ -105,120 +121,110 @@ cdef int _triangulate_pseudo_polygon(Tri* T, int32_t* chain, int32_t* ext, int32
     return top
 
 
-cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcept nogil:
-    """Insert the constrained edge from a toward b up to the first vertex on the segment
-    (b itself, or a vertex lying exactly on a-b); `reached` gets that vertex.
+cdef inline void _mark_edge(Tri* T, int e, uint8_t flag, int32_t seg) noexcept nogil:
+    """Add `flag` to the existing edge e (both twins); an input segment (seg >= 0)
+    also gives it its id unless it has one: where input segments overlap, the first
+    one inserted names the pieces (as Triangle keeps the first segment's marker)."""
+    T.eflag[e] |= flag
+    T.eflag[T.twin[e]] |= flag
+    if seg >= 0 and T.eseg[e] < 0:
+        T.eseg[e] = seg
+        T.eseg[T.twin[e]] = seg
 
-    The walk along a->b collects the crossed triangles and the chains of vertices to the
-    left and right.  A chain can visit a vertex twice: when every triangle around a
-    vertex is crossed (the segment passes close by it, crossing all its edges but one),
-    that vertex hangs inside the cavity on an edge that both neighbouring crossed
-    triangles share.  Such edges appear twice in a chain, once each way; after the
-    re-triangulation their two new half-edges are paired with each other."""
-    cdef int res, h, g, w, ow, u, v, ntri, nl, nr, i, j, nused, topr, topl, t0, nc
-    cdef int end = NONE
-    cdef int m = 64
-    cdef int32_t* tris
-    cdef int32_t* lch
-    cdef int32_t* rch
-    cdef int32_t* lorig
-    cdef int32_t* rorig
-    cdef int32_t* cch
-    cdef int32_t* corig
-    cdef int32_t* cext
-    cdef int32_t* cnew
-    cdef int32_t* cflag
-    cdef uint8_t state
-    cdef int32_t region
-    cdef int e = find_edge(T, a, b)
-    if e >= 0:
-        T.eflag[e] |= flag
-        T.eflag[T.twin[e]] |= flag
-        reached[0] = b
-        return 0
-    res = _first_crossing(T, a, b, &h)
-    if res < 0:
-        return res
-    if res == 1:
-        e = find_edge(T, a, h)
-        T.eflag[e] |= flag
-        T.eflag[T.twin[e]] |= flag
-        reached[0] = h
-        return 0
-    while True:
-        if reserve_buf(T, 15 * m):
-            return ERR_NOMEM
-        tris = T.buf
-        lch = T.buf + m
-        rch = T.buf + 2 * m
-        lorig = T.buf + 3 * m      # half-edge of chain edge lch[j+1] -> lch[j]
-        rorig = T.buf + 4 * m      # half-edge of chain edge rch[j] -> rch[j+1]
-        # the polygon in the form _triangulate_pseudo_polygon wants: the right chain,
-        # then the left chain reversed, one after the other (2m entries each)
-        cch = T.buf + 5 * m
-        corig = T.buf + 7 * m
-        cext = T.buf + 9 * m
-        # first triangle (a, x, y), h = x->y: right chain starts a->x, left chain y->a
-        t0 = h // 3
-        lch[0] = a
-        rch[0] = a
-        rch[1] = T.tv[h]
-        rorig[0] = prv(h)
-        nr = 2
-        lch[1] = T.tv[nxt(h)]
-        lorig[0] = nxt(h)
-        nl = 2
-        tris[0] = t0
-        ntri = 1
-        state = T.tstate[t0]
-        region = T.tregion[t0]
-        end = NONE
-        while ntri < m - 1 and nl < m - 1 and nr < m - 1:
-            if blocking(T, h):
-                T.err_a = a
-                T.err_b = b
-                T.err_u = T.tv[h]
-                T.err_v = T.tv[nxt(h)]
-                return ERR_CROSSING
-            g = T.twin[h]
-            u = T.tv[g]            # left end of the crossed edge
-            v = T.tv[nxt(g)]       # right end
-            w = T.tv[prv(g)]
-            if w == GHOST:
-                return ERR_INTERNAL
-            tris[ntri] = g // 3
-            ntri += 1
-            if w == b:
-                ow = 0
-            else:
-                ow = orient2d(P(T, a), P(T, b), P(T, w))
-            if ow == 0:
-                end = w
-                rch[nr] = w
-                rorig[nr - 1] = nxt(g)
-                nr += 1
-                lch[nl] = w
-                lorig[nl - 1] = prv(g)
-                nl += 1
-                break
-            if ow > 0:
-                lch[nl] = w
-                lorig[nl - 1] = prv(g)
-                nl += 1
-                h = nxt(g)
-            else:
-                rch[nr] = w
-                rorig[nr - 1] = nxt(g)
-                nr += 1
-                h = prv(g)
-        if end != NONE:
-            break
-        m *= 4
-        # restart with bigger buffers (nothing was modified yet)
-        if _first_crossing(T, a, b, &h) != 0:
+
+# The scratch buffer T.buf during one piece's insertion, for a capacity m (entries):
+#   [0, m)      tris   the crossed triangles (their slots are refilled)
+#   [m, 2m)     lch    left chain of vertices, from a
+#   [2m, 3m)    rch    right chain of vertices, from a
+#   [3m, 4m)    lorig  half-edge of left chain edge lch[j+1] -> lch[j]
+#   [4m, 5m)    rorig  half-edge of right chain edge rch[j] -> rch[j+1]
+#   then, 2m entries each, the two pseudo-polygons laid out one after the other (the
+#   right chain, then the left chain reversed) as _triangulate_pseudo_polygon wants:
+#   cch (vertices) at 5m, corig (old half-edges) at 7m, cext (outer twins) at 9m,
+#   cnew (new half-edges) at 11m, cflag at 13m, cseg (segment ids) at 15m.
+cdef enum:
+    CAVITY_BUF_PER_CAP = 17
+
+
+cdef int _walk_cavity(Tri* T, int a, int b, int h, int m, int* out) noexcept nogil:
+    """Walk along a->b from the half-edge h = x->y opposite a of the first crossed
+    triangle (a, x, y), collecting the crossed triangles and the left / right chains
+    into T.buf (layout above, capacity m), up to the first vertex w on the line a-b.
+
+    Returns 0 with out = (ntri, nl, nr, w), 1 when the capacity is too small (nothing
+    was modified), or ERR_CROSSING / ERR_INTERNAL.  A chain can visit a vertex twice:
+    when every triangle around a vertex is crossed (the segment passes close by it,
+    crossing all its edges but one), that vertex hangs inside the cavity on an edge
+    that both neighbouring crossed triangles share; such edges appear twice in a chain,
+    once each way (_refill_cavity pairs them)."""
+    cdef int32_t* tris = T.buf
+    cdef int32_t* lch = T.buf + m
+    cdef int32_t* rch = T.buf + 2 * m
+    cdef int32_t* lorig = T.buf + 3 * m
+    cdef int32_t* rorig = T.buf + 4 * m
+    cdef int g, w, ow, ntri = 1, nl = 2, nr = 2
+    # first triangle (a, x, y), h = x->y: right chain starts a->x, left chain y->a
+    lch[0] = a
+    rch[0] = a
+    rch[1] = T.tv[h]
+    rorig[0] = prv(h)
+    lch[1] = T.tv[nxt(h)]
+    lorig[0] = nxt(h)
+    tris[0] = h // 3
+    while ntri < m - 1 and nl < m - 1 and nr < m - 1:
+        if blocking(T, h):
+            T.err_a = a
+            T.err_b = b
+            T.err_u = T.tv[h]
+            T.err_v = T.tv[nxt(h)]
+            T.err_seg = T.eseg[h]
+            return ERR_CROSSING
+        g = T.twin[h]
+        w = T.tv[prv(g)]
+        if w == GHOST:
             return ERR_INTERNAL
-    # Lay out both polygons in c* arrays: right chain at [0, nr), left chain reversed at
-    # [nr, nr + nl).  Chain edge k of a polygon runs cch[k] -> cch[k+1].
+        tris[ntri] = g // 3
+        ntri += 1
+        ow = 0 if w == b else orient2d(P(T, a), P(T, b), P(T, w))
+        if ow >= 0:
+            lch[nl] = w
+            lorig[nl - 1] = prv(g)
+            nl += 1
+            h = nxt(g)
+        if ow <= 0:
+            rch[nr] = w
+            rorig[nr - 1] = nxt(g)
+            nr += 1
+            h = prv(g)
+        if ow == 0:
+            out[0] = ntri
+            out[1] = nl
+            out[2] = nr
+            out[3] = w
+            return 0
+    return 1
+
+
+cdef int _refill_cavity(Tri* T, int m, int ntri, int nl, int nr, uint8_t state,
+                        int32_t region, int* tops) noexcept nogil:
+    """Replace the crossed triangles that _walk_cavity collected by the CDTs of the
+    two pseudo-polygons on either side of the new edge, in the same slots; tops =
+    (right, left) half-edges of the new edge (not yet twinned or flagged).  Chain edges
+    with the cavity on both sides are paired with each other."""
+    cdef int32_t* tris = T.buf
+    cdef int32_t* lch = T.buf + m
+    cdef int32_t* rch = T.buf + 2 * m
+    cdef int32_t* lorig = T.buf + 3 * m
+    cdef int32_t* rorig = T.buf + 4 * m
+    cdef int32_t* cch = T.buf + 5 * m
+    cdef int32_t* corig = T.buf + 7 * m
+    cdef int32_t* cext = T.buf + 9 * m
+    cdef int32_t* cnew = T.buf + 11 * m
+    cdef int32_t* cflag = T.buf + 13 * m
+    cdef int32_t* cseg = T.buf + 15 * m
+    cdef int i, j, e, g, nused = 0, nc = nr + nl
+    # right chain at [0, nr), left chain reversed at [nr, nr + nl); chain edge k of a
+    # polygon runs cch[k] -> cch[k+1]
     for i in range(nr):
         cch[i] = rch[i]
     for i in range(nr - 1):
@@ -227,10 +233,7 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
         cch[nr + i] = lch[nl - 1 - i]
     for i in range(nl - 1):
         corig[nr + i] = lorig[nl - 2 - i]
-    nc = nr + nl
-    # Mark the cavity, then find each chain edge's outer twin and flags.
-    cnew = T.buf + 11 * m
-    cflag = T.buf + 13 * m
+    # mark the cavity, then find each chain edge's outer twin, flags and segment id
     for i in range(ntri):
         T.tstate[tris[i]] = T_FREE
     for i in range(nc):
@@ -238,16 +241,17 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
             continue                # the last vertex of a chain starts no chain edge
         e = corig[i]
         cflag[i] = T.eflag[e]
+        cseg[i] = T.eseg[e]
         g = T.twin[e]
         cext[i] = g if T.tstate[g // 3] != T_FREE else NONE
-    nused = 0
-    topr = _triangulate_pseudo_polygon(T, cch, cext, cnew, nr - 1, tris, &nused, state, region)
-    if topr < 0:
-        return topr
-    topl = _triangulate_pseudo_polygon(T, cch + nr, cext + nr, cnew + nr, nl - 1, tris,
-                                       &nused, state, region)
-    if topl < 0:
-        return topl
+    tops[0] = _triangulate_pseudo_polygon(T, cch, cext, cnew, nr - 1, tris, &nused,
+                                          state, region)
+    if tops[0] < 0:
+        return tops[0]
+    tops[1] = _triangulate_pseudo_polygon(T, cch + nr, cext + nr, cnew + nr, nl - 1, tris,
+                                          &nused, state, region)
+    if tops[1] < 0:
+        return tops[1]
     if nused != ntri:
         return ERR_INTERNAL
     # pair up the chain edges that had the cavity on both sides
@@ -261,25 +265,70 @@ cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int* reached) noexcep
                     and cch[j] == cch[i + 1] and cch[j + 1] == cch[i]):
                 T.twin[cnew[i]] = cnew[j]
                 T.eflag[cnew[i]] = <uint8_t> cflag[i]
+                T.eseg[cnew[i]] = cseg[i]
                 break
         else:
             return ERR_INTERNAL
-    T.twin[topr] = topl
-    T.twin[topl] = topr
-    T.eflag[topr] = flag
-    T.eflag[topl] = flag
-    T.last = topr // 3
-    reached[0] = end
     return 0
 
 
-cdef int insert_segment(Tri* T, int a, int b, uint8_t flag) noexcept nogil:
+cdef int _insert_piece(Tri* T, int a, int b, uint8_t flag, int32_t seg,
+                       int* reached) noexcept nogil:
+    """Insert the constrained edge from a toward b up to the first vertex on the segment
+    (b itself, or a vertex lying exactly on a-b); `reached` gets that vertex.  The new
+    edge gets `flag` and segment id `seg`; the cavity's other edges keep theirs.  The
+    walk (_walk_cavity) collects the crossed triangles, _refill_cavity retriangulates
+    them."""
+    cdef int res, h, t0
+    cdef int m = CAVITY_INITIAL_CAP
+    cdef int walked[4]
+    cdef int tops[2]
+    cdef int e = find_edge(T, a, b)
+    if e >= 0:
+        _mark_edge(T, e, flag, seg)
+        reached[0] = b
+        return 0
+    res = _first_crossing(T, a, b, &h)
+    if res < 0:
+        return res
+    if res == 1:
+        e = find_edge(T, a, h)
+        _mark_edge(T, e, flag, seg)
+        reached[0] = h
+        return 0
+    while True:
+        if reserve_buf(T, CAVITY_BUF_PER_CAP * m):
+            return ERR_NOMEM
+        res = _walk_cavity(T, a, b, h, m, walked)
+        if res <= 0:
+            break
+        m *= 4                  # restart with bigger buffers (nothing was modified yet)
+    if res < 0:
+        return res
+    t0 = h // 3
+    res = _refill_cavity(T, m, walked[0], walked[1], walked[2], T.tstate[t0],
+                         T.tregion[t0], tops)
+    if res < 0:
+        return res
+    T.twin[tops[0]] = tops[1]
+    T.twin[tops[1]] = tops[0]
+    T.eflag[tops[0]] = flag
+    T.eflag[tops[1]] = flag
+    T.eseg[tops[0]] = seg
+    T.eseg[tops[1]] = seg
+    T.last = tops[0] // 3
+    reached[0] = walked[3]
+    return 0
+
+
+cdef int insert_segment(Tri* T, int a, int b, uint8_t flag, int32_t seg) noexcept nogil:
     """Make a-b an edge of the triangulation with `flag` set on it (on each piece, if
-    vertices lie exactly on a-b: the segment is then split there).  Returns 0, or 1 if
-    it was split, or a negative error code."""
+    vertices lie exactly on a-b: the segment is then split there), each piece carrying
+    segment id `seg` (-1 for a temporary constraint).  Returns 0, or 1 if it was split,
+    or a negative error code."""
     cdef int reached = NONE, res, guard = 0
     while a != b:
-        res = _insert_piece(T, a, b, flag, &reached)
+        res = _insert_piece(T, a, b, flag, seg, &reached)
         if res < 0:
             return res
         a = reached
@@ -287,55 +336,3 @@ cdef int insert_segment(Tri* T, int a, int b, uint8_t flag) noexcept nogil:
         if guard > T.nv + 1:
             return ERR_INTERNAL
     return 1 if guard > 1 else 0
-
-
-# ---------------------------------------------------------------- flood fills
-
-cdef int flood(Tri* T, int nseed, uint8_t from_state, uint8_t to_state, int32_t region,
-               bint set_region) noexcept nogil:
-    """Spread from the triangles T.stack[0:nseed] across edges that are not segments,
-    changing every reached triangle of state from_state to to_state (and its region)."""
-    cdef int sp = nseed, t, k, e, u
-    while sp > 0:
-        sp -= 1
-        t = T.stack[sp]
-        if T.tstate[t] != from_state:
-            continue
-        T.tstate[t] = to_state
-        if set_region:
-            T.tregion[t] = region
-        for k in range(3):
-            e = 3 * t + k
-            if T.eflag[e] & E_SEGMENT:
-                continue
-            u = T.twin[e] // 3
-            if T.tstate[u] == from_state:
-                if reserve_stack(T, sp + 1):
-                    return ERR_NOMEM
-                T.stack[sp] = u
-                sp += 1
-    return 0
-
-
-# Seeds of the flood fills: hole and region points located in the triangulation.
-
-cdef bint _vertex_on_segment(Tri* T, int v) noexcept nogil:
-    """Whether a constrained edge ends at v (a seed located on v lies on a segment)."""
-    cdef int e0 = T.vhe[v], e = e0
-    while True:
-        if T.eflag[e] & E_SEGMENT:
-            return True
-        e = T.twin[prv(e)]
-        if e == e0:
-            return False
-
-
-cdef int _seed_triangle(Tri* T, int loc, int where) noexcept nogil:
-    """The triangle a flood fill starts from for a seed point located at (loc, where)."""
-    if loc == LOC_IN_TRIANGLE:
-        return where
-    if loc == LOC_ON_EDGE:
-        return where // 3
-    if loc == LOC_ON_VERTEX:
-        return T.vhe[where] // 3
-    return NONE

@@ -13,8 +13,36 @@
 #   * Update_internal inserts R into cd(S(E)) and makes sure F and G are edges.
 # The heap only orders the work (Get_next_edge); it is not the definition of C, so
 # stale entries are simply skipped (lazy deletion).
-
+#
+# Uses: halfedge.pxd; aft.pxd (Aft, HeapItem); sizing.pxi (size_at); predicates.pxi;
+# triangulation.pxi (find_edge, insert_vertex_at, add_vertex, legalize_meshed,
+# reserve_stack, _grow); cdt.pxi (insert_segment).
+from halfedge cimport *
+from aft cimport Aft, HeapItem
 from libc.math cimport sqrt, floor, log2
+from libc.stdlib cimport malloc, free
+from libc.string cimport memset
+
+# Tuning constants of the compiled loop (each with the reason for its value).
+# Compute_new_candidate keeps |R - a| = |R - b| between these multiples of |E|: below
+# 0.55 |E| the new triangle's apex angle would exceed about 130 degrees, above 2 |E| its
+# base angles would exceed about 75 degrees, where the size grows faster than the front.
+cdef double SIDE_MIN_FACTOR = 0.55
+cdef double SIDE_MAX_FACTOR = 2.0
+# Get_next_edge compares lengths in classes of 2**(1/8) (about 9 %): the key is
+# floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(|E|^2)), i.e. eighths of an octave of |E|.
+cdef double LENGTH_CLASSES_PER_OCTAVE_SQ = 4.0
+cdef enum:
+    # steps between two looks at Python's signal handlers and the progress callable:
+    # rare enough to cost nothing, frequent enough for Ctrl-C to answer within ~10 ms
+    SIGNAL_CHECK_INTERVAL = 8192
+    # is_crowded looks at no more triangles than this: the cavity within close_factor
+    # * h of R holds a handful of near-equilateral triangles; more means a crowd anyway
+    CROWD_SEARCH_MAX = 32
+    HEAP_INITIAL_CAP = 1024     # grown by doubling
+    LR_INITIAL_CAP = 64         # Check_visible's crossed-edge lists, grown by doubling
+# New_is_preferred's default: take S when |S - R| < DEFAULT_CLOSE_FACTOR * h
+cdef double DEFAULT_CLOSE_FACTOR = 0.5
 
 from cpython.ref cimport PyObject
 
@@ -26,62 +54,18 @@ cdef extern from "Python.h":
     void PyErr_Fetch(PyObject** ptype, PyObject** pvalue, PyObject** ptraceback)
     void PyErr_Restore(PyObject* ptype, PyObject* pvalue, PyObject* ptraceback)
 
-cdef enum:
-    ORDER_SHORTEST = 0
-    ORDER_LONGEST = 1
-    ORDER_OLDEST = 2
-
-cdef struct HeapItem:
-    double key
-    int64_t seq         # insertion count: ties and oldest-first
-    int32_t he          # the half-edge when pushed (it may move; org/dst identify it)
-    int32_t org
-    int32_t dst
-
-cdef struct Aft:
-    HeapItem* heap
-    int heap_n, heap_cap
-    int64_t seq
-    int order
-    SizeField size
-    int64_t max_triangles   # N_max of formula (4); < 0: none
-    double min_area         # A_min of formula (5); <= 0: none
-    double close_factor     # New_is_preferred takes S when |S - R| < close_factor * h
-    bint swaps              # Add_triangle keeps the meshed region a CDT by edge swaps
-    bint greedy             # New_is_preferred is always false
-    int64_t n_meshed        # N(T)
-    int64_t n_unmeshed      # triangles of the unmeshed CDT
-    int64_t n_new           # vertices created by Update_internal
-    int64_t n_steps         # passes through the while loop
-    int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
-    # Check_visible's output: crossed edges of the line of sight, and where R lies
-    int32_t* left
-    int32_t* right
-    int nleft, nright, lr_cap
-    int vis_loc, vis_where
-    # progress: meshed / total area, reported to a Python callable (a borrowed
-    # reference kept alive by the owning Triangulation) every few thousand steps
-    double area_total, area_meshed
-    void* progress
-    # the exception a signal handler raised (Ctrl-C's KeyboardInterrupt, a watchdog's
-    # own exception), held here until the def layer can raise it again
-    PyObject* exc_type
-    PyObject* exc_value
-    PyObject* exc_tb
-
-
 cdef int aft_init(Aft* A) noexcept nogil:
     memset(A, 0, sizeof(Aft))
-    A.heap_cap = 1024
+    A.heap_cap = HEAP_INITIAL_CAP
     A.heap = <HeapItem*> malloc(A.heap_cap * sizeof(HeapItem))
-    A.lr_cap = 64
+    A.lr_cap = LR_INITIAL_CAP
     A.left = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
     A.right = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
     A.size.nx = 1
     A.size.ny = 1
     A.size.h = <double*> malloc(sizeof(double))
     A.max_triangles = -1
-    A.close_factor = 0.5
+    A.close_factor = DEFAULT_CLOSE_FACTOR
     A.swaps = True
     if A.heap == NULL or A.left == NULL or A.right == NULL or A.size.h == NULL:
         return ERR_NOMEM
@@ -90,7 +74,10 @@ cdef int aft_init(Aft* A) noexcept nogil:
 
 
 cdef void aft_free(Aft* A) noexcept nogil:
-    free(A.heap); free(A.left); free(A.right); free(A.size.h)
+    free(A.heap)
+    free(A.left)
+    free(A.right)
+    free(A.size.h)
     memset(A, 0, sizeof(Aft))
 
 
@@ -124,9 +111,9 @@ cdef int heap_push(Aft* A, Tri* T, int e) noexcept nogil:
     # would sweep the whole domain before the other boundaries' layers started;
     # classes make the fronts of equal size advance together, layer by layer.
     if A.order == ORDER_SHORTEST:
-        item.key = floor(4.0 * log2(dx * dx + dy * dy))
+        item.key = floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(dx * dx + dy * dy))
     elif A.order == ORDER_LONGEST:
-        item.key = -floor(4.0 * log2(dx * dx + dy * dy))
+        item.key = -floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(dx * dx + dy * dy))
     else:
         item.key = 0.0
     q = A.heap
@@ -225,8 +212,9 @@ cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
 cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
     """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
     distance from a and b that the local size asks for (an equilateral triangle when
-    |E| equals the size), kept between 0.55 |E| and 2 |E| so that the triangle's shape
-    stays reasonable where the size changes faster than the front."""
+    |E| equals the size), kept between SIDE_MIN_FACTOR |E| and SIDE_MAX_FACTOR |E| so
+    that the triangle's shape stays reasonable where the size changes faster than the
+    front."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
@@ -248,10 +236,10 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
 
 
 cdef inline double _side_length(double h, double L) noexcept nogil:
-    if h < 0.55 * L:
-        return 0.55 * L
-    if h > 2.0 * L:
-        return 2.0 * L
+    if h < SIDE_MIN_FACTOR * L:
+        return SIDE_MIN_FACTOR * L
+    if h > SIDE_MAX_FACTOR * L:
+        return SIDE_MAX_FACTOR * L
     return h
 
 
@@ -391,7 +379,7 @@ cdef int check_visible(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
 
 
 cdef inline double _dist2_point_segment(const double* p, const double* a,
-                                       const double* b) noexcept nogil:
+                                        const double* b) noexcept nogil:
     cdef double ex = b[0] - a[0], ey = b[1] - a[1]
     cdef double px = p[0] - a[0], py = p[1] - a[1]
     cdef double L2 = ex * ex + ey * ey, s = 0.0
@@ -433,7 +421,7 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
     cdef double de2 = 0.25 * dv2
     cdef double dx, dy
     cdef bint seen
-    if reserve_stack(T, 32):
+    if reserve_stack(T, CROWD_SEARCH_MAX):
         return ERR_NOMEM
     if A.vis_loc == LOC_IN_TRIANGLE:
         T.stack[0] = A.vis_where
@@ -457,7 +445,7 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
                 if _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) < de2:
                     return 1
                 continue
-            if n >= 32 or _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) >= dv2:
+            if n >= CROWD_SEARCH_MAX or _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) >= dv2:
                 continue            # the triangle beyond lies outside the search disk
             u = T.twin[e] // 3
             seen = False
@@ -530,10 +518,10 @@ cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
         return ERR_INTERNAL
     if T.tv[prv(f)] != v:
         A.n_forced += 1
-        res = insert_segment(T, a, v, E_FIXED)
+        res = insert_segment(T, a, v, E_FIXED, -1)
         if res < 0:
             return res
-        res = insert_segment(T, v, b, E_FIXED)
+        res = insert_segment(T, v, b, E_FIXED, -1)
         if res < 0:
             return res
         f = find_edge(T, a, b)
@@ -551,17 +539,22 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
     """One pass through Figure 5's while loop for the current edge e."""
     cdef double R[2]
     cdef double h
-    cdef int S, t, vis
+    cdef int S, t, vis, crowded
     cdef bint new
     compute_new_candidate(A, T, e, R, &h)
     S = compute_existing_candidate(T, e)
     new = new_is_preferred(A, T, e, R, S, h) and not mesh_size_constraint(A, T, e, R)
     if new:
         vis = check_visible(A, T, e, R)
-        if vis == 1:
-            vis = 1 - is_crowded(A, T, R, h)
         if vis < 0:
             return vis
+        if vis == 1:
+            # is_crowded answers 1 / 0 or an error code, which must stop the loop
+            # rather than read as "crowded"
+            crowded = is_crowded(A, T, R, h)
+            if crowded < 0:
+                return crowded
+            vis = 0 if crowded else 1
         new = vis == 1
     if new:
         t = update_internal(A, T, e, R)
@@ -599,7 +592,7 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
         if res < 0:
             return res
         count += 1
-        if count % 8192 == 0:
+        if count % SIGNAL_CHECK_INTERVAL == 0:
             if check_signals(A) != 0:
                 return ERR_INTERRUPTED
             with gil:

@@ -18,6 +18,11 @@
 #   third vertex is GHOST (a symbolic point at infinity), so every walk and every
 #   rotation around a vertex stays inside the arrays.  The public API sees -1 there.
 # * eflag[e] holds E_SEGMENT / E_FIXED and is always written on both twins together.
+# * eseg[e] is the provenance of a constrained edge: the index of the input segment
+#   (the row given to insert_segment) it is a piece of, or -1 (not an input segment:
+#   a temporary constraint, or no constraint).  Like eflag it is written on both twins
+#   together and moves with the edge through every rewrite (set_tri), so pieces of a
+#   split segment and edges rebuilt by a retriangulation keep their segment's id.
 # * vhe[v] is one half-edge leaving v (tv[vhe[v]] == v).
 # * tstate[t] says whether a triangle is outside the domain, still unmeshed, or meshed;
 #   the frontal edge set C of the paper is implicit: a half-edge is a front edge exactly
@@ -28,28 +33,36 @@ cdef enum:
     GHOST = -1          # the vertex at infinity of ghost triangles
     NONE = -1           # no half-edge / no triangle
 
-    # eflag bits
+# The named enums below are mirrored in Python by src/aftmesh/_states.py (IntEnums);
+# tests/test_states.py checks the two agree through _kernel's *_VALUES dicts.
+
+cdef enum EdgeFlag:     # bits of eflag
     E_SEGMENT = 1       # an input edge (boundary, interface, crack): never flipped
     E_FIXED = 2         # a temporary constraint (F, G while Update_internal inserts them)
 
-    # tstate values
+cdef enum TriState:     # values of tstate
     T_FREE = 0          # slot not in use (only transiently, inside a re-triangulation)
     T_EXTERIOR = 1      # ghost triangles, outside the domain, holes
     T_UNMESHED = 2      # part of the unmeshed region S(E) of the paper
     T_MESHED = 3        # part of the mesh T built so far
 
-    # status codes returned by kernel routines (0 = success)
+cdef enum Status:       # returned by kernel routines (0 or a count = success)
     ERR_NOMEM = -1
     ERR_CROSSING = -2   # a new edge would cross a constrained edge (T.err_* say which)
     ERR_COLLINEAR = -3  # all points on one line: no triangle exists
     ERR_INTERNAL = -4   # an invariant broke: a bug, reported instead of looping or crashing
     ERR_INTERRUPTED = -5
 
-    # results of locate()
+cdef enum Location:     # results of locate()
     LOC_IN_TRIANGLE = 0
     LOC_ON_EDGE = 1
     LOC_ON_VERTEX = 2
     LOC_OUTSIDE = 3     # strictly outside the convex hull: the answer is a ghost triangle
+
+cdef enum Order:        # Get_next_edge's order of the heap
+    ORDER_SHORTEST = 0  # shortest front edge first (length classes, oldest within one)
+    ORDER_LONGEST = 1
+    ORDER_OLDEST = 2    # first in, first out
 
 cdef struct Tri:
     double* xy          # 2 doubles per vertex
@@ -58,10 +71,12 @@ cdef struct Tri:
     int32_t* tv         # 3 per triangle
     int32_t* twin       # 3 per triangle
     uint8_t* eflag      # 3 per triangle
+    int32_t* eseg       # 3 per triangle: input segment id, -1 if none
     uint8_t* tstate     # 1 per triangle
     int32_t* tregion    # 1 per triangle
-    int32_t nt, nt_cap  # slots handed out so far / allocated (no slot is ever given
-                        # back: every re-triangulation refills the slots it empties)
+    # slots handed out so far / allocated (no slot is ever given back: every
+    # re-triangulation refills the slots it empties)
+    int32_t nt, nt_cap
     int32_t last        # a live finite triangle where the next walk starts
     uint32_t rng        # xorshift state for the stochastic walk
     # scratch stacks, grown on demand, never shrunk
@@ -71,6 +86,7 @@ cdef struct Tri:
     int32_t buf_cap
     # where the last ERR_CROSSING came from: new edge (err_a, err_b) hit edge (err_u, err_v)
     int32_t err_a, err_b, err_u, err_v
+    int32_t err_seg     # ... which is a piece of input segment err_seg (-1: none)
 
 
 cdef inline int nxt(int e) noexcept nogil:
@@ -81,3 +97,19 @@ cdef inline int prv(int e) noexcept nogil:
 
 cdef inline int tri_of(int e) noexcept nogil:
     return e // 3
+
+cdef inline double* P(Tri* T, int v) noexcept nogil:
+    return &T.xy[2 * v]
+
+
+cdef inline bint is_ghost(Tri* T, int t) noexcept nogil:
+    return T.tv[3 * t] == GHOST or T.tv[3 * t + 1] == GHOST or T.tv[3 * t + 2] == GHOST
+
+
+cdef inline bint blocking(Tri* T, int e) noexcept nogil:
+    """A constrained edge: an input segment, a temporary constraint, or the boundary
+    between two triangles of different state (which makes every front edge constrained
+    for the walks, flips and retriangulations of the unmeshed CDT)."""
+    if T.eflag[e] & (E_SEGMENT | E_FIXED):
+        return True
+    return T.tstate[e // 3] != T.tstate[T.twin[e] // 3]

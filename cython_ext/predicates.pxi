@@ -174,6 +174,7 @@
 # value-changing optimisation: setup.py passes -ffp-contract=off and never
 # -ffast-math.
 
+# Uses: nothing else of the kernel (the predicates never touch topology).
 from libc.math cimport fabs, fma
 
 
@@ -581,11 +582,11 @@ cdef inline double _pred_incircle_first_order_term(const double* dd, const doubl
     # and minor' = ext fy + ex fyt - fxt ey - fx eyt.  Roundings on any path:
     # minor 2, lift 2, lift'/2 2, minor' 4; products 5 and 7; the sum 8.
     cdef double m = dd[e] * dd[f + 1] - dd[f] * dd[e + 1]
-    cdef double l = dd[p] * dd[p] + dd[p + 1] * dd[p + 1]
+    cdef double lift = dd[p] * dd[p] + dd[p + 1] * dd[p + 1]
     cdef double lp = dd[p] * tl[p] + dd[p + 1] * tl[p + 1]
     cdef double mp = (((tl[e] * dd[f + 1] + dd[e] * tl[f + 1]) - tl[f] * dd[e + 1])
                       - dd[f] * tl[e + 1])
-    return (2.0 * lp) * m + l * mp
+    return (2.0 * lp) * m + lift * mp
 
 
 cdef inline int _pred_incircle_adapt_path(const double* a, const double* b, const double* c,
@@ -672,7 +673,8 @@ cdef int _pred_incircle_adapt(const double* a, const double* b, const double* c,
 # provably correct, _pred_undecided otherwise.
 # ---------------------------------------------------------------------------
 
-cdef inline int _pred_orient2d_filter(const double* a, const double* b, const double* c) noexcept nogil:
+cdef inline int _pred_orient2d_filter(const double* a, const double* b,
+                                      const double* c) noexcept nogil:
     cdef double detleft = (b[0] - a[0]) * (c[1] - a[1])
     cdef double detright = (b[1] - a[1]) * (c[0] - a[0])
     cdef double det = detleft - detright
@@ -739,7 +741,8 @@ cdef inline int orient2d(const double* a, const double* b, const double* c) noex
     return _pred_orient2d_exact(a, b, c)
 
 
-cdef inline int incircle(const double* a, const double* b, const double* c, const double* d) noexcept nogil:
+cdef inline int incircle(const double* a, const double* b, const double* c,
+                         const double* d) noexcept nogil:
     cdef int s = _pred_incircle_filter(a, b, c, d)
     if s != _pred_undecided:
         return s
@@ -752,14 +755,16 @@ cdef inline int incircle(const double* a, const double* b, const double* c, cons
 def py_orient2d(double ax, double ay, double bx, double by, double cx, double cy):
     """Exact sign (-1, 0, +1) of the orientation of (a, b, c); +1 = counter-clockwise."""
     cdef double p[6]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy
+    p[:] = [ax, ay, bx, by, cx, cy]
     return orient2d(&p[0], &p[2], &p[4])
 
 
-def py_incircle(double ax, double ay, double bx, double by, double cx, double cy, double dx, double dy):
-    """Exact sign (-1, 0, +1) of incircle(a, b, c, d); +1 = d inside when a, b, c are counter-clockwise."""
+def py_incircle(double ax, double ay, double bx, double by, double cx, double cy,
+                double dx, double dy):
+    """Exact sign (-1, 0, +1) of incircle(a, b, c, d); +1 = d inside when a, b, c are
+    counter-clockwise."""
     cdef double p[8]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy; p[6] = dx; p[7] = dy
+    p[:] = [ax, ay, bx, by, cx, cy, dx, dy]
     return incircle(&p[0], &p[2], &p[4], &p[6])
 
 
@@ -768,7 +773,7 @@ def py_incircle(double ax, double ay, double bx, double by, double cx, double cy
 def _pred_py_orient2d_stages(double ax, double ay, double bx, double by, double cx, double cy):
     """(filter verdict or None if undecided, exact-stage sign)."""
     cdef double p[6]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy
+    p[:] = [ax, ay, bx, by, cx, cy]
     cdef int f = _pred_orient2d_filter(&p[0], &p[2], &p[4])
     cdef int e = _pred_orient2d_exact(&p[0], &p[2], &p[4])
     return (None if f == _pred_undecided else f), e
@@ -778,7 +783,7 @@ def _pred_py_incircle_stages(double ax, double ay, double bx, double by, double 
                              double dx, double dy):
     """(filter verdict or None if undecided, exact-stage sign)."""
     cdef double p[8]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy; p[6] = dx; p[7] = dy
+    p[:] = [ax, ay, bx, by, cx, cy, dx, dy]
     cdef int f = _pred_incircle_filter(&p[0], &p[2], &p[4], &p[6])
     cdef int e = _pred_incircle_exact(&p[0], &p[2], &p[4], &p[6])
     return (None if f == _pred_undecided else f), e
@@ -797,7 +802,7 @@ def _pred_error_bound_tails():
 def py_orient2d_stage_b(double ax, double ay, double bx, double by, double cx, double cy):
     """Exact-differences stage of orient2d alone: its sign, or None if it abstains."""
     cdef double p[6]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy
+    p[:] = [ax, ay, bx, by, cx, cy]
     cdef int s = _pred_orient2d_adapt(&p[0], &p[2], &p[4])
     return None if s == _pred_undecided else s
 
@@ -806,7 +811,7 @@ def py_incircle_stage_b(double ax, double ay, double bx, double by, double cx, d
                         double dx, double dy):
     """Exact-differences stage of incircle alone: its sign, or None if it abstains."""
     cdef double p[8]
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy; p[6] = dx; p[7] = dy
+    p[:] = [ax, ay, bx, by, cx, cy, dx, dy]
     cdef int s = _pred_incircle_adapt(&p[0], &p[2], &p[4], &p[6])
     return None if s == _pred_undecided else s
 
@@ -821,7 +826,7 @@ def _pred_py_incircle_stage_b_path(double ax, double ay, double bx, double by,
     'tails' (bound (T))."""
     cdef double p[8]
     cdef int path = -1
-    p[0] = ax; p[1] = ay; p[2] = bx; p[3] = by; p[4] = cx; p[5] = cy; p[6] = dx; p[7] = dy
+    p[:] = [ax, ay, bx, by, cx, cy, dx, dy]
     cdef int s = _pred_incircle_adapt_path(&p[0], &p[2], &p[4], &p[6], &path)
     names = ("inexact", "split", "sweep1", "sweeps", "grown", "tails")
     return (None if s == _pred_undecided else s), names[path]

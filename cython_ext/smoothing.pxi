@@ -2,9 +2,25 @@
 #
 # Each pass moves every vertex that Basic_aft created (the input vertices never move)
 # to the best of a few candidate places, judged by the worst shape of its triangles,
-# when that keeps them all counter-clockwise (exact orient2d), and then restores the constrained Delaunay
-# property by Lawson flips over the whole mesh, so the result is still the CDT of its
-# vertices and the input edges.
+# when that keeps them all counter-clockwise (exact orient2d), and then restores the
+# constrained Delaunay property by Lawson flips over the whole mesh, so the result is
+# still the CDT of its
+# vertices and the input edges.  Flips never touch constrained edges, so every input
+# segment keeps its pieces and their ids (eseg).
+#
+# Uses: halfedge.pxd; aft.pxd (Aft); predicates.pxi (orient2d); triangulation.pxi
+# (legalize_meshed, reserve_stack); front.pxi (check_signals).
+from halfedge cimport *
+from aft cimport Aft
+
+# A vertex whose triangles all have a shape above this is left alone: nearly all are,
+# after Basic_aft, and the skip saves most of the work of a pass.
+cdef double SMOOTH_SKIP_SHAPE = 0.985
+# A candidate place must beat the current worst shape by this much, so that rounding
+# noise alone never moves a vertex (and the passes stop).
+cdef double SMOOTH_MIN_GAIN = 1e-6
+cdef enum:
+    SMOOTH_MAX_DEGREE = 64      # a vertex with more triangles than this is not moved
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
     """4 sqrt(3) area / (sum of squared edge lengths): 1 for an equilateral triangle,
@@ -47,7 +63,7 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
     opposite v), and two steps towards the ideal apex of its worst triangle.  The move
     is kept only if it improves the worst shape (so smoothing never makes the worst
     triangle around a vertex worse) and every triangle stays counter-clockwise (exact
-    orient2d).  A vertex whose triangles are all nearly equilateral (shape > 0.985) is
+    orient2d).  A vertex whose triangles are all nearly equilateral (SMOOTH_SKIP_SHAPE) is
     left alone: most are, which saves most of the work.  Returns 1 if v moved."""
     cdef int e0 = T.vhe[v], e = e0, guard = 0, n = 0, u, w, k
     cdef double lx = 0.0, ly = 0.0, ix = 0.0, iy = 0.0, ax, ay, mx, my, q, worst_q = 2.0
@@ -82,9 +98,9 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
         guard += 1
         if e == e0:
             break
-        if guard > 64:
+        if guard > SMOOTH_MAX_DEGREE:
             return 0
-    if worst_q > 0.985:
+    if worst_q > SMOOTH_SKIP_SHAPE:
         return 0                    # all its triangles are nearly equilateral already
     best = worst_q
     bx = T.xy[2 * v]
@@ -101,7 +117,7 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
             ax = cx + t * (wx - cx)
             ay = cy + t * (wy - cy)
         q = _try_at(T, v, e0, ax, ay)
-        if q > best + 1e-6:
+        if q > best + SMOOTH_MIN_GAIN:
             best = q
             bx = ax
             by = ay

@@ -1,8 +1,20 @@
 # Half-edge triangulation: storage, flips, point location and point insertion.
 # Conventions: halfedge.pxd.  Geometry is only ever read through the predicates.
-
+#
+# Uses: halfedge.pxd (Tri, enums, nxt/prv, P, is_ghost, blocking); predicates.pxi
+# (orient2d, incircle).
+from halfedge cimport *
 from libc.stdlib cimport malloc, realloc, free
 from libc.string cimport memset
+
+cdef enum:
+    SCRATCH_INITIAL_CAP = 256   # T.stack / T.buf, grown on demand
+    # locate()'s stochastic walk gives up after WALK_CAP_BASE + WALK_CAP_PER_TRIANGLE
+    # * nt steps (far beyond any real walk) and scans all triangles exactly instead
+    WALK_CAP_BASE = 64
+    WALK_CAP_PER_TRIANGLE = 4
+# any non-zero xorshift seed works; fixed so that runs are reproducible
+cdef uint32_t WALK_RNG_SEED = 2463534242u
 
 
 # ---------------------------------------------------------------- storage
@@ -19,24 +31,34 @@ cdef int tri_init(Tri* T, int nv_cap, int nt_cap) noexcept nogil:
     T.tv = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.twin = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.eflag = <uint8_t*> malloc(3 * nt_cap * sizeof(uint8_t))
+    T.eseg = <int32_t*> malloc(3 * nt_cap * sizeof(int32_t))
     T.tstate = <uint8_t*> malloc(nt_cap * sizeof(uint8_t))
     T.tregion = <int32_t*> malloc(nt_cap * sizeof(int32_t))
     T.nt_cap = nt_cap
-    T.stack_cap = 256
+    T.stack_cap = SCRATCH_INITIAL_CAP
     T.stack = <int32_t*> malloc(T.stack_cap * sizeof(int32_t))
-    T.buf_cap = 256
+    T.buf_cap = SCRATCH_INITIAL_CAP
     T.buf = <int32_t*> malloc(T.buf_cap * sizeof(int32_t))
     T.last = NONE
-    T.rng = 2463534242u
+    T.rng = WALK_RNG_SEED
     if (T.xy == NULL or T.vhe == NULL or T.tv == NULL or T.twin == NULL or T.eflag == NULL
-            or T.tstate == NULL or T.tregion == NULL or T.stack == NULL or T.buf == NULL):
+            or T.eseg == NULL or T.tstate == NULL or T.tregion == NULL or T.stack == NULL
+            or T.buf == NULL):
         return ERR_NOMEM
     return 0
 
 
 cdef void tri_free(Tri* T) noexcept nogil:
-    free(T.xy); free(T.vhe); free(T.tv); free(T.twin); free(T.eflag)
-    free(T.tstate); free(T.tregion); free(T.stack); free(T.buf)
+    free(T.xy)
+    free(T.vhe)
+    free(T.tv)
+    free(T.twin)
+    free(T.eflag)
+    free(T.eseg)
+    free(T.tstate)
+    free(T.tregion)
+    free(T.stack)
+    free(T.buf)
     memset(T, 0, sizeof(Tri))
 
 
@@ -70,6 +92,7 @@ cdef int reserve_triangles(Tri* T, int n) noexcept nogil:
     if (_grow(<void**> &T.tv, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.twin, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.eflag, 3 * cap * sizeof(uint8_t)) or
+            _grow(<void**> &T.eseg, 3 * cap * sizeof(int32_t)) or
             _grow(<void**> &T.tstate, cap * sizeof(uint8_t)) or
             _grow(<void**> &T.tregion, cap * sizeof(int32_t))):
         return ERR_NOMEM
@@ -120,28 +143,13 @@ cdef int new_triangle(Tri* T) noexcept nogil:
     return T.nt - 1
 
 
-cdef inline double* P(Tri* T, int v) noexcept nogil:
-    return &T.xy[2 * v]
-
-
-cdef inline bint is_ghost(Tri* T, int t) noexcept nogil:
-    return T.tv[3 * t] == GHOST or T.tv[3 * t + 1] == GHOST or T.tv[3 * t + 2] == GHOST
-
-
-cdef inline bint blocking(Tri* T, int e) noexcept nogil:
-    """A constrained edge: an input segment, a temporary constraint, or the boundary
-    between two triangles of different state (which makes every front edge constrained
-    for the walks, flips and retriangulations of the unmeshed CDT)."""
-    if T.eflag[e] & (E_SEGMENT | E_FIXED):
-        return True
-    return T.tstate[e // 3] != T.tstate[T.twin[e] // 3]
-
-
 cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
                          int ta, int tb, int tc, uint8_t fa, uint8_t fb, uint8_t fc,
+                         int32_t sa, int32_t sb, int32_t sc,
                          uint8_t state, int32_t region) noexcept nogil:
     """Write triangle t = (a, b, c) with outer twins ta, tb, tc (NONE: set later by the
-    triangle on the other side) and edge flags fa, fb, fc; links the twins back."""
+    triangle on the other side), edge flags fa, fb, fc and segment ids sa, sb, sc;
+    links the twins back."""
     cdef int e = 3 * t
     T.tv[e] = a
     T.tv[e + 1] = b
@@ -152,15 +160,21 @@ cdef inline void set_tri(Tri* T, int t, int a, int b, int c,
     T.eflag[e] = fa
     T.eflag[e + 1] = fb
     T.eflag[e + 2] = fc
+    T.eseg[e] = sa
+    T.eseg[e + 1] = sb
+    T.eseg[e + 2] = sc
     if ta >= 0:
         T.twin[ta] = e
         T.eflag[ta] = fa
+        T.eseg[ta] = sa
     if tb >= 0:
         T.twin[tb] = e + 1
         T.eflag[tb] = fb
+        T.eseg[tb] = sb
     if tc >= 0:
         T.twin[tc] = e + 2
         T.eflag[tc] = fc
+        T.eseg[tc] = sc
     if a >= 0:
         T.vhe[a] = e
     if b >= 0:
@@ -196,10 +210,11 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef int32_t ie1 = T.eseg[e1], ie2 = T.eseg[e2], if1 = T.eseg[f1], if2 = T.eseg[f2]
     cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
     cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
-    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, s0, r0)
-    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, s1, r1)
+    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, ie2, if1, -1, s0, r0)
+    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, if2, ie1, -1, s1, r1)
 
 
 cdef inline int in_circle_ext(Tri* T, int a, int b, int c, int d) noexcept nogil:
@@ -342,7 +357,7 @@ cdef int locate(Tri* T, const double* p, int start, int* where) noexcept nogil:
     (so it cannot cycle forever on a constrained triangulation) and is capped; past the
     cap it falls back to an exact scan of all triangles."""
     cdef int t = start if start >= 0 else T.last
-    cdef int steps = 0, cap = 64 + 4 * T.nt
+    cdef int steps = 0, cap = WALK_CAP_BASE + WALK_CAP_PER_TRIANGLE * T.nt
     cdef int k, i, e, r
     cdef int o3[3]
     if t < 0 or t >= T.nt or T.tstate[t] == T_FREE:
@@ -388,6 +403,7 @@ cdef int split_triangle(Tri* T, int t, int v) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e + 1], c = T.tv[e + 2]
     cdef int tw0 = T.twin[e], tw1 = T.twin[e + 1], tw2 = T.twin[e + 2]
     cdef uint8_t f0 = T.eflag[e], f1 = T.eflag[e + 1], f2 = T.eflag[e + 2]
+    cdef int32_t i0 = T.eseg[e], i1 = T.eseg[e + 1], i2 = T.eseg[e + 2]
     cdef uint8_t s = T.tstate[t]
     cdef int32_t r = T.tregion[t]
     cdef int t1 = new_triangle(T)
@@ -396,9 +412,9 @@ cdef int split_triangle(Tri* T, int t, int v) noexcept nogil:
     cdef int t2 = new_triangle(T)
     if t2 < 0:
         return ERR_NOMEM
-    set_tri(T, t, a, b, v, tw0, NONE, NONE, f0, 0, 0, s, r)
-    set_tri(T, t1, b, c, v, tw1, NONE, 3 * t + 1, f1, 0, 0, s, r)
-    set_tri(T, t2, c, a, v, tw2, 3 * t + 2, 3 * t1 + 1, f2, 0, 0, s, r)
+    set_tri(T, t, a, b, v, tw0, NONE, NONE, f0, 0, 0, i0, -1, -1, s, r)
+    set_tri(T, t1, b, c, v, tw1, NONE, 3 * t + 1, f1, 0, 0, i1, -1, -1, s, r)
+    set_tri(T, t2, c, a, v, tw2, 3 * t + 2, 3 * t1 + 1, f2, 0, 0, i2, -1, -1, s, r)
     if reserve_stack(T, 3):
         return ERR_NOMEM
     T.stack[0] = 3 * t
@@ -419,7 +435,9 @@ cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
+    cdef int32_t ie1 = T.eseg[e1], ie2 = T.eseg[e2], if1 = T.eseg[f1], if2 = T.eseg[f2]
     cdef uint8_t g = T.eflag[e]
+    cdef int32_t ig = T.eseg[e]     # both halves stay pieces of the same segment
     cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
     cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
     cdef int t2 = new_triangle(T)
@@ -429,10 +447,10 @@ cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
     if t3 < 0:
         return ERR_NOMEM
     # (b, c, v) (c, a, v) on t0's side; (a, d, v) (d, b, v) on t1's side
-    set_tri(T, t0, b, c, v, te1, NONE, NONE, ge1, 0, g, s0, r0)
-    set_tri(T, t2, c, a, v, te2, NONE, 3 * t0 + 1, ge2, g, 0, s0, r0)
-    set_tri(T, t1, a, d, v, tf1, NONE, 3 * t2 + 1, gf1, 0, g, s1, r1)
-    set_tri(T, t3, d, b, v, tf2, 3 * t0 + 2, 3 * t1 + 1, gf2, g, 0, s1, r1)
+    set_tri(T, t0, b, c, v, te1, NONE, NONE, ge1, 0, g, ie1, -1, ig, s0, r0)
+    set_tri(T, t2, c, a, v, te2, NONE, 3 * t0 + 1, ge2, g, 0, ie2, ig, -1, s0, r0)
+    set_tri(T, t1, a, d, v, tf1, NONE, 3 * t2 + 1, gf1, 0, g, if1, -1, ig, s1, r1)
+    set_tri(T, t3, d, b, v, tf2, 3 * t0 + 2, 3 * t1 + 1, gf2, g, 0, if2, ig, -1, s1, r1)
     if reserve_stack(T, 4):
         return ERR_NOMEM
     T.stack[0] = 3 * t0
@@ -488,10 +506,12 @@ cdef int make_first_triangle(Tri* T, int a, int b, int c) noexcept nogil:
     if t < 0 or g0 < 0 or g1 < 0 or g2 < 0:
         return ERR_NOMEM
     # ghost gk sits across edge k of t: (b, a, G), (c, b, G), (a, c, G)
-    set_tri(T, t, a, b, c, NONE, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g0, b, a, GHOST, 3 * t, NONE, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g1, c, b, GHOST, 3 * t + 1, 3 * g0 + 2, NONE, 0, 0, 0, T_UNMESHED, 0)
-    set_tri(T, g2, a, c, GHOST, 3 * t + 2, 3 * g1 + 2, 3 * g0 + 1, 0, 0, 0, T_UNMESHED, 0)
+    set_tri(T, t, a, b, c, NONE, NONE, NONE, 0, 0, 0, -1, -1, -1, T_UNMESHED, 0)
+    set_tri(T, g0, b, a, GHOST, 3 * t, NONE, NONE, 0, 0, 0, -1, -1, -1, T_UNMESHED, 0)
+    set_tri(T, g1, c, b, GHOST, 3 * t + 1, 3 * g0 + 2, NONE, 0, 0, 0, -1, -1, -1,
+            T_UNMESHED, 0)
+    set_tri(T, g2, a, c, GHOST, 3 * t + 2, 3 * g1 + 2, 3 * g0 + 1, 0, 0, 0, -1, -1, -1,
+            T_UNMESHED, 0)
     T.last = t
     return 0
 
@@ -510,3 +530,37 @@ cdef int find_edge(Tri* T, int a, int b) noexcept nogil:
         guard += 1
         if e == e0 or guard > T.nt * 3 + 3:
             return NONE
+
+
+cdef int insert_points(Tri* T, const int32_t* order, int m, int32_t* merged) noexcept nogil:
+    """Start the triangulation and insert the vertices order[0..m) in that order (a
+    spatially coherent order keeps the walks short).  merged[v] gets the vertex at
+    exactly the same place that v was merged into (it is left as is for the inserted
+    vertices).  Returns 0, ERR_COLLINEAR when all the points lie on one line, or an
+    error."""
+    cdef int i, v, first, second = NONE, third = NONE, res, pos
+    # a non-degenerate first triangle: the first point, the next distinct one, and the
+    # next one off their line
+    first = order[0]
+    for i in range(1, m):
+        v = order[i]
+        if T.xy[2 * v] != T.xy[2 * first] or T.xy[2 * v + 1] != T.xy[2 * first + 1]:
+            if second == NONE:
+                second = v
+            elif orient2d(P(T, first), P(T, second), P(T, v)) != 0:
+                third = v
+                break
+    if third == NONE:
+        return ERR_COLLINEAR
+    res = make_first_triangle(T, first, second, third)
+    if res < 0:
+        return res
+    for i in range(m):
+        v = order[i]
+        if v == first or v == second or v == third:
+            continue
+        pos = insert_vertex(T, v, NONE)
+        if pos < 0:
+            return pos
+        merged[v] = pos
+    return 0

@@ -1,84 +1,24 @@
-"""``aftmesh.cdt``: the constrained Delaunay triangulation of a PSLG, no points added."""
+"""``aftmesh.cdt``: the constrained Delaunay triangulation of a PSLG, no points added
+(unless crossing segments are to be split at their crossing points)."""
 from __future__ import annotations
 
 import numpy as np
 
-from . import _kernel
+from .domain import node_crossings
+from .errors import InvalidOptionError
 from .mesh import Mesh
-from .pslg import build_cdt
+from .pslg import as_points, as_segments, build_cdt
 
 __all__ = ["cdt"]
 
-
-def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.ndarray,
-                    in_segments: np.ndarray, to_out: np.ndarray) -> np.ndarray:
-    """For each output segment, the index of the input segment it is (a piece of).
-
-    ``to_out`` maps input vertex -> output vertex.  Pieces of a split input segment are
-    found by walking from its first end along output segments collinear with it."""
-    markers = np.full(len(out_segments), -1, dtype=np.int32)
-    if len(out_segments) == 0 or len(in_segments) == 0:
-        return markers
-    # the common case, vectorized: an input segment that is an output segment as is
-    n = max(int(len(points)), 1)
-    out_key = np.sort(out_segments.astype(np.int64), axis=1)
-    out_key = out_key[:, 0] * n + out_key[:, 1]
-    ends = to_out[in_segments].astype(np.int64)
-    whole = (ends >= 0).all(axis=1)
-    in_key = np.sort(ends, axis=1)
-    in_key = in_key[:, 0] * n + in_key[:, 1]
-    order = np.argsort(out_key)
-    pos = np.minimum(np.searchsorted(out_key[order], in_key), len(order) - 1)
-    hit = whole & (out_key[order][pos] == in_key)
-    # later input segments win on duplicates, as in the loop below
-    markers[order[pos[hit]]] = np.flatnonzero(hit).astype(np.int32)
-    rest = np.flatnonzero(~hit)
-    if len(rest) == 0:
-        return markers
-    index = {}
-    for k, (u, v) in enumerate(out_segments.tolist()):
-        index[(u, v)] = k
-        index[(v, u)] = k
-    adjacency: dict[int, list[int]] = {}
-    for u, v in out_segments:
-        adjacency.setdefault(int(u), []).append(int(v))
-        adjacency.setdefault(int(v), []).append(int(u))
-    for j in rest.tolist():
-        a, b = int(in_segments[j, 0]), int(in_segments[j, 1])
-        u, v = int(to_out[a]), int(to_out[b])
-        if u < 0:
-            # walk from the end that is in the output (a segment can leave the domain
-            # through a boundary vertex; its outside part is carved away)
-            u, v, a, b = v, u, b, a
-        if u < 0:
-            continue
-        # a split segment: follow collinear pieces from u towards b's input position
-        pa, pb = in_points[a], in_points[b]
-        cur, prev, guard = u, -1, 0
-        while cur != v and guard <= len(points):
-            guard += 1
-            step = -1
-            for w in adjacency.get(cur, ()):
-                if w == prev:
-                    continue
-                pw = points[w]
-                if _kernel.py_orient2d(pa[0], pa[1], pb[0], pb[1], pw[0], pw[1]) != 0:
-                    continue
-                if np.dot(pw - points[cur], pb - pa) > 0 and np.dot(pb - pw, pb - pa) >= 0:
-                    step = w
-                    break
-            if step < 0:
-                break
-            markers[index[(cur, step)]] = j
-            prev, cur = cur, step
-    return markers
+CROSSINGS = ("raise", "split")
 
 
-def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
+def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise") -> Mesh:
     """Constrained Delaunay triangulation of a planar straight-line graph.
 
-    No point is added.  A segment that runs exactly through an input vertex is split
-    there; segments that cross raise :class:`aftmesh.CrossingSegmentsError`.
+    No point is added, unless ``crossings="split"``.  A segment that runs exactly
+    through an input vertex is split there.
 
     Parameters
     ----------
@@ -91,6 +31,16 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
     regions : sequence of (x, y, marker), optional
         Each triangle of the segment-bounded region containing (x, y) gets ``marker``
         in ``Mesh.regions`` (0 elsewhere).
+    crossings : {"raise", "split"}, keyword-only
+        What to do with segments that cross at a point interior to both.  ``"raise"``
+        (the default) raises :class:`aftmesh.CrossingSegmentsError` naming both, so
+        the output's vertices are exactly the input's.  ``"split"`` inserts each
+        crossing point (computed once, rounded to the nearest double, and shared by
+        the segments through it) and splits the segments there, repeating until no
+        crossing remains, as Triangle's ``p`` switch does.  The points are listed in
+        ``info['crossings']``: ``points`` (k, 2), ``segments`` (the input segment
+        indices crossing there, one tuple per point) and ``vertices`` (their indices
+        in ``Mesh.points``).
 
     Returns
     -------
@@ -98,6 +48,8 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
         With segments given, the triangles inside closed rings of segments (minus
         holes); without, the whole convex hull.  ``info['vertex_map']`` maps each
         input vertex to its output index (-1: merged away or outside the domain).
+        ``segment_markers`` gives, for each output segment, the input segment it is a
+        piece of (the kernel carries it through every split and retriangulation).
 
     Examples
     --------
@@ -110,11 +62,81 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
     >>> m = aftmesh.cdt(square, ring, holes=[(1, 1)])
     >>> m.n_triangles, round(m.area(), 12)
     (8, 3.0)
+
+    Two diagonals of a square cross at its centre; ``"split"`` inserts that point:
+
+    >>> corners = [(0, 0), (2, 0), (2, 2), (0, 2)]
+    >>> edges = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2), (1, 3)]
+    >>> m = aftmesh.cdt(corners, edges, crossings="split")
+    >>> m.n_triangles, m.info["crossings"]["points"].tolist(), m.info["crossings"]["segments"]
+    (4, [[1.0, 1.0]], [(4, 5)])
+    >>> sorted(m.segment_markers.tolist())     # each diagonal is now two pieces
+    [0, 1, 2, 3, 4, 4, 5, 5]
     """
-    built = build_cdt(vertices, segments, holes, regions)
-    a = built.kernel.arrays()
-    to_out = a["vertex_map"][built.merged]
-    markers = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
-    info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
+    if not isinstance(crossings, str) or crossings not in CROSSINGS:
+        raise InvalidOptionError(
+            f"crossings={crossings!r} is not a valid option, must be one of {list(CROSSINGS)}")
+    noded = _split_crossings(vertices, segments) if crossings == "split" else None
+    if noded is None:
+        built = build_cdt(vertices, segments, holes, regions)
+        a = built.kernel.arrays()
+        to_out = a["vertex_map"][built.merged]
+        markers = a["segment_ids"]     # the kernel's provenance of each output segment
+        info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
+        if crossings == "split":
+            info["crossings"] = _no_crossings()
+    else:
+        verts, segs, src, to_noded, n_merged = noded
+        built = build_cdt(verts, segs, holes, regions)
+        a = built.kernel.arrays()
+        noded_out = a["vertex_map"][built.merged]
+        ids = a["segment_ids"]
+        markers = np.where(ids >= 0, src[np.maximum(ids, 0)], -1).astype(np.int32)
+        info = {"merged_vertices": n_merged, "vertex_map": noded_out[to_noded],
+                "crossings": _crossing_report(verts, segs, src, to_noded, noded_out)}
     return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
-                segments=a["segments"], regions=a["regions"], segment_markers=markers, info=info)
+                       segments=a["segments"], regions=a["regions"], segment_markers=markers,
+                       info=info)
+
+
+def _split_crossings(vertices, segments):
+    """Node the crossing segments (domain.node_crossings: crossing points computed
+    once, cut points ordered along a segment by exact coordinate comparison, repeated
+    until nothing crosses; vertices are snapped only when exactly on a segment).
+    Returns None when nothing crosses, else (vertices, segments, source segment of
+    each piece, input vertex -> noded vertex, number of merged input vertices)."""
+    pts = as_points(vertices, "vertices")
+    seg = as_segments(segments, len(pts), pts)
+    if len(seg) < 2:
+        return None
+    note: list[str] = []
+    src = np.arange(len(seg), dtype=np.int64)
+    verts, segs, src = node_crossings(pts, seg.astype(np.int64), src, note, tol=0.0)
+    if not note:
+        return None
+    # node_crossings keeps every input coordinate exactly (np.unique): find them again
+    index = {p: i for i, p in enumerate(map(tuple, verts.tolist()))}
+    to_noded = np.array([index[p] for p in map(tuple, pts.tolist())], dtype=np.int64)
+    n_merged = len(pts) - len(np.unique(to_noded))
+    return (np.ascontiguousarray(verts), np.asarray(segs, dtype=np.int32),
+            np.asarray(src, dtype=np.int32), to_noded, n_merged)
+
+
+def _no_crossings():
+    return {"points": np.zeros((0, 2)), "segments": [], "vertices": np.zeros(0, np.int32)}
+
+
+def _crossing_report(verts, segs, src, to_noded, noded_out):
+    """The inserted points: coordinates, the input segments through each, and their
+    index in the output."""
+    is_new = np.ones(len(verts), dtype=bool)
+    is_new[to_noded] = False
+    through: dict[int, set[int]] = {}
+    for (u, w), s in zip(segs.tolist(), src.tolist()):
+        for v in (u, w):
+            if is_new[v]:
+                through.setdefault(v, set()).add(s)
+    new = np.flatnonzero(is_new)
+    return {"points": verts[new].copy(),
+            "segments": [tuple(sorted(through.get(int(v), ()))) for v in new],
+            "vertices": noded_out[new].astype(np.int32)}

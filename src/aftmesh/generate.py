@@ -7,9 +7,9 @@ import time
 import numpy as np
 import shapely
 
+from ._states import Order
 from .aft import Strategy, basic_aft
 from .boundary import discretize
-from .cdt import segment_markers
 from .domain import classify_pieces, node_crossings, snap_tolerance, to_domain
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
                      InvalidSizeError)
@@ -19,7 +19,7 @@ from .sizing import DEFAULT_GRADATION, make_size_field, per_region_size
 
 __all__ = ["generate"]
 
-_ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
+_ORDERS = {o.name.lower(): o for o in Order}
 MAX_SMOOTH = 1000           # smoothing rounds; it stops earlier once nothing moves
 # Kernel indices are int32: refuse a request for more triangles than that can number
 MAX_TRIANGLES = 2 ** 30
@@ -307,8 +307,7 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         moves = kernel.smooth(len(verts), int(smooth))
     t_aft = time.perf_counter()
     a = kernel.arrays()
-    to_out = a["vertex_map"][built.merged]
-    pieces = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
+    pieces = a["segment_ids"]      # the kernel's provenance of each output segment
     markers = np.where(pieces >= 0, src[np.maximum(pieces, 0)], -1).astype(np.int32)
     if dom.source_markers is not None:
         markers = np.where(markers >= 0, dom.source_markers[np.maximum(markers, 0)], -1)

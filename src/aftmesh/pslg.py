@@ -20,6 +20,7 @@ import numpy as np
 
 from . import _kernel
 from ._order import brio_order
+from ._states import TriangleState
 from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 
 # The exact predicates are exact for coordinates that are 0 or of magnitude between
@@ -105,25 +106,6 @@ def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
     return seg.astype(np.int32)
 
 
-def _segment_containing(vertices, segments, u, v):
-    """Index of the input segment that the kernel edge (u, v) is (a piece of)."""
-    pu, pv = vertices[u], vertices[v]
-    for j, (a, b) in enumerate(segments):
-        if {int(a), int(b)} == {u, v}:
-            return j
-    for j, (a, b) in enumerate(segments):
-        pa, pb = vertices[a], vertices[b]
-        d = pb - pa
-        cu = d[0] * (pu[1] - pa[1]) - d[1] * (pu[0] - pa[0])
-        cv = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
-        if cu == 0 and cv == 0:
-            tu = np.dot(pu - pa, d) / np.dot(d, d)
-            tv = np.dot(pv - pa, d) / np.dot(d, d)
-            if -1e-12 <= min(tu, tv) and max(tu, tv) <= 1 + 1e-12:
-                return j
-    return -1
-
-
 def build_cdt(vertices, segments=None, holes=None, regions=None, *,
               carve: bool | None = None, nt_hint: int = 0) -> BuiltCDT:
     """Validate a PSLG and return the kernel triangulation of its domain.
@@ -170,8 +152,8 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     try:
         n_split = kernel.insert_segments(np.ascontiguousarray(kseg, dtype=np.int32))
     except _kernel.CrossingError as err:
-        i = err.index
-        j = _segment_containing(pts, seg, *err.blocker)
+        # the kernel knows exactly which input segment the blocking edge is a piece of
+        i, j = err.index, err.blocker_segment
         a, b = seg[i]
         if j >= 0:
             c, d = seg[j]
@@ -186,11 +168,11 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
     for name, rows in (("holes", hole_pts), ("regions", reg[:, :2])):
         for i, (x, y) in enumerate(rows):
             state = kernel.state_at(x, y)
-            if state == 0:
+            if state is None:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) lies on a segment, so it picks no "
                     "single region: put it strictly inside")
-            if state != 2:
+            if state != TriangleState.UNMESHED:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain")
     kernel.carve(hole_pts, False)

@@ -1,0 +1,44 @@
+# The state of the compiled Basic_aft loop (routines in front.pxi, smoothing.pxi):
+# the heap of Get_next_edge, the options, the counters and Check_visible's output.
+from libc.stdint cimport int32_t, int64_t
+from cpython.ref cimport PyObject
+
+from sizing cimport SizeField
+
+cdef struct HeapItem:
+    double key
+    int64_t seq         # insertion count: ties and oldest-first
+    int32_t he          # the half-edge when pushed (it may move; org/dst identify it)
+    int32_t org
+    int32_t dst
+
+cdef struct Aft:
+    HeapItem* heap
+    int heap_n, heap_cap
+    int64_t seq
+    int order
+    SizeField size
+    int64_t max_triangles   # N_max of formula (4); < 0: none
+    double min_area         # A_min of formula (5); <= 0: none
+    double close_factor     # New_is_preferred takes S when |S - R| < close_factor * h
+    bint swaps              # Add_triangle keeps the meshed region a CDT by edge swaps
+    bint greedy             # New_is_preferred is always false
+    int64_t n_meshed        # N(T)
+    int64_t n_unmeshed      # triangles of the unmeshed CDT
+    int64_t n_new           # vertices created by Update_internal
+    int64_t n_steps         # passes through the while loop
+    int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
+    # Check_visible's output: crossed edges of the line of sight, and where R lies
+    int32_t* left
+    int32_t* right
+    int nleft, nright, lr_cap
+    int vis_loc, vis_where
+    # progress: meshed / total area, reported to a Python callable (a borrowed
+    # reference kept alive by the owning Triangulation) every few thousand steps
+    double area_total, area_meshed
+    void* progress
+    # the exception a signal handler raised (Ctrl-C's KeyboardInterrupt, a watchdog's
+    # own exception), held here until the def layer can raise it again
+    PyObject* exc_type
+    PyObject* exc_value
+    PyObject* exc_tb
