@@ -33,9 +33,13 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         (one ring), a Triangle-style dict (``vertices``, ``segments``, ``holes``,
         ``regions``), or the path of a ``.poly`` file.
     size : float, callable, sequence or None
-        Target edge length: a number, ``f(x, y) -> array`` (called on whole arrays), one
-        number per region (with a sequence of polygons as the domain), or None to take
-        it from the lengths of the input edges.  A size must span at least 64 units in
+        Target edge length: a number; a callable ``f(x, y)``; one number per region
+        (with a sequence of polygons as the domain); or None to take it from the
+        lengths of the input edges.  The callable is called a few times, each time
+        with two 1-D float arrays ``x``, ``y`` of equal length (many points at once,
+        never one call per point), and must return an array of that length (one size
+        per point) or a single number; any other shape raises InvalidSizeError.  So
+        ``lambda x, y: h(np.c_[x, y])`` works for any ``h`` taking (n, 2) points.  A size must span at least 64 units in
         the last place of the largest coordinate (about 1e-14 of it); a finer one
         raises InvalidSizeError.
     max_triangles : int, optional

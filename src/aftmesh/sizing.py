@@ -1,7 +1,8 @@
 """Size specifications -> the compiled size field (a background grid).
 
 A user's ``size`` is a number (the target edge length everywhere), a callable
-``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point), or
+``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point: x
+and y are 1-D arrays of equal length, the result one size per point or a scalar), or
 ``None`` (sizes taken from the lengths of the boundary's own edges and spread inward).
 Whatever it is, it becomes a regular grid of target lengths that the kernel
 interpolates bilinearly, after a gradation limit has been applied so that the size
@@ -103,16 +104,29 @@ def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
 
 
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """The user's size at the grid nodes, in one call: ``size(x, y)`` with x and y
+    1-D arrays of equal length (the nodes row by row), returning that many sizes or
+    one number.  1-D because that is what point-based tools take (``np.c_[x, y]``,
+    KD-trees, interpolators, ``shapely.distance`` of points)."""
+    x = np.ascontiguousarray(X, dtype=np.float64).reshape(-1)
+    y = np.ascontiguousarray(Y, dtype=np.float64).reshape(-1)
     try:
-        out = size(X, Y)
+        out = size(x, y)
     except Exception as exc:  # the user's function failed: say so, keep the cause
         raise InvalidSizeError(f"the size callable raised {type(exc).__name__}: {exc}") from exc
     try:
-        h = np.broadcast_to(np.asarray(out, dtype=np.float64), X.shape).copy()
+        values = np.asarray(out, dtype=np.float64)
     except (TypeError, ValueError) as exc:
+        raise InvalidSizeError(f"the size callable must return numbers: {exc}") from None
+    if values.ndim == 0:
+        h = np.full(X.shape, float(values))
+    elif values.shape == x.shape:
+        h = values.reshape(X.shape).copy()
+    else:
         raise InvalidSizeError(
-            f"the size callable must return numbers broadcastable to shape {X.shape} "
-            f"(it is called with two arrays): {exc}") from None
+            f"the size callable returned an array of shape {values.shape}: it is called "
+            f"with 1-D arrays x, y of length {len(x)} and must return an array of that "
+            "length (one size per point) or a single number")
     _check_values(h, X, Y, "the size callable")
     return h
 
