@@ -267,6 +267,7 @@ def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Op
         "compiled_loop": opts.compiled,
         "size_field": field,
         "timing": timing,
+        **dom.report,
     }
     return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
                        segments=a["segments"], regions=a["regions"], segment_markers=markers,

@@ -21,7 +21,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
              min_area: float | None = None, order: str = "shortest", greedy: bool = False,
              swaps: bool = True, split_boundary: bool = True,
              gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
-             smooth: int = 3, strategy: Strategy | None = None, progress=None) -> Mesh:
+             smooth: int = 3, strategy: Strategy | None = None, progress=None,
+             repair: bool = False, tolerance: float = 0.0, boundary_tags=None) -> Mesh:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -81,6 +82,27 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         A progress bar (fraction of the area meshed) on standard error: by default
         shown only when standard error is a terminal and the mesh is large; True or
         False to force it; a callable ``f(fraction)`` to receive the fraction instead.
+    repair : bool
+        Make invalid polygons valid first with ``shapely.make_valid`` (shapely,
+        ring or sequence-of-polygons input): the polygonal part is meshed, the
+        zero-width slivers it produces are dropped, constraint lines and points in
+        or on the repaired domain are kept, and ``info['repair']`` lists what was
+        repaired (``'repaired'``) and dropped (``'dropped'``).  Default False: an
+        invalid polygon raises InvalidDomainError naming the ring at fault.
+    tolerance : float
+        Absolute distance below which vertices are merged and a constraint line's
+        end or bend is snapped onto a segment it nearly touches (shapely, ring or
+        sequence-of-polygons input); ``info['tolerance']`` counts what it changed
+        (``'merged'``, ``'snapped'``).  Default 0: exact, only exact duplicates
+        merge.  Vertices on a straight run of a ring are kept either way.
+    boundary_tags : mapping, optional
+        Names for parts of the boundary: ``{name: selector}``, the selector either a
+        callable ``f(x, y) -> bool array`` (called once, on the midpoints of all
+        input edges as 1-D arrays) or a sequence of input-edge indices (numbered as
+        ``Mesh.segment_sources``).  Tags are numbered 1, 2, ... in mapping order;
+        the mesh gets ``segment_tags`` and ``tag_names``, and
+        ``mesh.boundary_facets(name)`` returns the segments of a name.  An edge
+        selected by two names raises InvalidOptionError.
 
     Returns
     -------
@@ -101,8 +123,10 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     opts = check_options(order=order, max_triangles=max_triangles, min_area=min_area,
                          greedy=greedy, swaps=swaps, split_boundary=split_boundary,
                          gradation=gradation, close_factor=close_factor, smooth=smooth,
-                         strategy=strategy, progress=progress)
-    dom = to_domain(domain, keep_vertices=not opts.split_boundary)
+                         strategy=strategy, progress=progress, repair=repair,
+                         tolerance=tolerance, boundary_tags=boundary_tags)
+    dom = to_domain(domain, keep_vertices=not opts.split_boundary,
+                    tolerance=opts.tolerance, repair=opts.repair)
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
     field, expected = _stages.size_field(dom, size, opts.gradation)

@@ -23,6 +23,7 @@ from shapely.geometry import (GeometryCollection, LineString, MultiLineString, M
 from .errors import InvalidDomainError, InvalidInputError
 from .noding import merge_and_node, refuse_crossings, snap_tolerance, split_at_vertices
 from .pslg import as_points, as_segments, check_range
+from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
 
 __all__ = ["Domain", "to_domain"]
@@ -57,6 +58,7 @@ class Domain:
     cleanup: list[str] = field(default_factory=list)
     source_markers: np.ndarray | None = None    # the user's marker of each source
     edge_midpoints: np.ndarray | None = None    # (e, 2) the midpoint of each input edge
+    report: dict = field(default_factory=dict)  # what repair / tolerance changed
 
     @property
     def segment_source(self) -> np.ndarray:
@@ -102,10 +104,12 @@ class _Chains:
         self.n_vertices += len(pts)
 
 
-def _ring_chain(coords: np.ndarray, note: list[str], name: str, keep_collinear: bool):
+def _ring_chain(coords: np.ndarray, note: list[str], name: str):
     """A ring's distinct vertices in order, each with the index of its outgoing input
     edge: a run of repeated vertices is kept once, as its last copy, whose outgoing
-    edge is the one that leaves the run."""
+    edge is the one that leaves the run.  Vertices on a straight run of the ring stay:
+    users put them there on purpose (a load point, a sensor, where a boundary
+    condition changes); near-coincident ones are merged by the tolerance instead."""
     c = np.asarray(coords, dtype=np.float64)
     closed = len(c) > 1 and (c[0] == c[-1]).all()
     n = len(c) - 1 if closed else len(c)
@@ -117,32 +121,7 @@ def _ring_chain(coords: np.ndarray, note: list[str], name: str, keep_collinear: 
         note.append(f"{name}: removed {int(n - keep.sum())} repeated vertices")
     ids = np.flatnonzero(keep)
     mid = 0.5 * (open_c + np.roll(open_c, -1, axis=0))
-    ring = open_c[keep]
-    if not keep_collinear:
-        ring, ids = _drop_collinear(ring, ids, note, name)
-    return ring, ids, n, mid
-
-
-def _drop_collinear(c, ids, note, name):
-    """Drop the vertices inside straight runs of the ring (exact orientation)."""
-    from ._kernel import py_orient2d
-    removed = 0
-    changed = True
-    while changed and len(c) > 3:
-        changed = False
-        n = len(c)
-        mask = np.ones(n, dtype=bool)
-        for i in range(n):
-            a, b, d = c[i - 1], c[i], c[(i + 1) % n]
-            if mask[i - 1] and py_orient2d(a[0], a[1], b[0], b[1], d[0], d[1]) == 0 \
-                    and np.dot(b - a, d - b) > 0:
-                mask[i] = False
-                removed += 1
-                changed = True
-        c, ids = c[mask], ids[mask]
-    if removed:
-        note.append(f"{name}: merged {removed} vertices of collinear runs")
-    return c, ids
+    return open_c[keep], ids, n, mid
 
 
 def _line_chain(coords: np.ndarray):
@@ -155,8 +134,7 @@ def _line_chain(coords: np.ndarray):
 
 
 def _from_shapely(polygons: list[Polygon], lines: list, line_names: list[str],
-                  points: list, names: list[str], tolerance: float = 0.0,
-                  keep_collinear: bool = True) -> Domain:
+                  points: list, names: list[str], tolerance: float = 0.0) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain."""
     note: list[str] = []
     chains = _Chains()
@@ -165,8 +143,7 @@ def _from_shapely(polygons: list[Polygon], lines: list, line_names: list[str],
             (f"hole {i}", h) for i, h in enumerate(poly.interiors)]
         for rname, ring in rings:
             name = f"{names[k]}, {rname}"
-            c, ids, n_edges, mid = _ring_chain(np.asarray(ring.coords)[:, :2], note, name,
-                                               keep_collinear)
+            c, ids, n_edges, mid = _ring_chain(np.asarray(ring.coords)[:, :2], note, name)
             chains.add(c, ids, n_edges, True, name, mid)
     for line, name in zip(lines, line_names):
         c, ids, n_edges, mid = _line_chain(np.asarray(line.coords)[:, :2])
@@ -179,12 +156,14 @@ def _from_shapely(polygons: list[Polygon], lines: list, line_names: list[str],
     edge_source = (np.concatenate(chains.edge_source) if chains.edge_source
                    else np.zeros(0, np.int64)).astype(np.int32)
     is_ring = np.asarray(chains.is_ring, dtype=bool)[edge_source]
-    verts, segs, edges = merge_and_node(verts, segs, edges, note, is_ring, tolerance)
+    report: dict = {}
+    verts, segs, edges = merge_and_node(verts, segs, edges, note, is_ring, tolerance, report)
     union_area = float(shapely.union_all(polygons).area)
     mids = np.concatenate(chains.midpoints) if chains.midpoints else np.zeros((0, 2))
     return Domain(verts, segs.astype(np.int32), edges.astype(np.int32), edge_source,
                   chains.names, edge_is_ring=is_ring, polygons=polygons, area=union_area,
-                  cleanup=note, edge_midpoints=mids)
+                  cleanup=note, edge_midpoints=mids,
+                  report={"tolerance": report} if report else {})
 
 
 def _dict_regions(regions):
@@ -281,8 +260,7 @@ def _split_geometry(domain):
     return polygons, lines, line_names, points
 
 
-def from_geometry(domain, tolerance: float = 0.0,
-                  keep_collinear: bool = True) -> Domain:
+def from_geometry(domain, tolerance: float = 0.0) -> Domain:
     """A shapely Polygon / MultiPolygon / GeometryCollection (its lines and points
     are internal constraints)."""
     polygons, lines, line_names, points = _split_geometry(domain)
@@ -292,15 +270,14 @@ def from_geometry(domain, tolerance: float = 0.0,
              for k in range(len(polygons))]
     for k, p in enumerate(polygons):
         check_polygon(p, names[k])
-    check_lines_inside(polygons, lines, line_names, points)
+    check_lines_inside(polygons, lines, line_names, points, tolerance)
     single = shapely.union_all(polygons)
     if isinstance(single, Polygon):
         polygons, names = [single], ["the polygon"]
-    return _from_shapely(polygons, lines, line_names, points, names, tolerance, keep_collinear)
+    return _from_shapely(polygons, lines, line_names, points, names, tolerance)
 
 
-def from_ring(arr: np.ndarray, tolerance: float = 0.0,
-                  keep_collinear: bool = True) -> Domain:
+def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:
     """An (n, 2) array of coordinates: one polygon ring."""
     bad = ~np.isfinite(arr).all(axis=1)
     if bad.any():
@@ -313,7 +290,7 @@ def from_ring(arr: np.ndarray, tolerance: float = 0.0,
     except (ValueError, TypeError) as exc:
         raise InvalidDomainError(f"the ring is not a polygon: {exc}") from None
     check_polygon(poly, "the polygon")
-    return _from_shapely([poly], [], [], [], ["the polygon"], tolerance, keep_collinear)
+    return _from_shapely([poly], [], [], [], ["the polygon"], tolerance)
 
 
 def _region_polygon(k: int, item):
@@ -327,8 +304,7 @@ def _region_polygon(k: int, item):
     raise InvalidDomainError(f"region {k} is a {type(item).__name__}, expected a polygon")
 
 
-def from_regions(items: list, tolerance: float = 0.0,
-                  keep_collinear: bool = True) -> Domain:
+def from_regions(items: list, tolerance: float = 0.0) -> Domain:
     """A sequence of polygons with disjoint interiors: one region each."""
     if not items:
         raise InvalidDomainError("the domain is an empty sequence")
@@ -351,7 +327,7 @@ def from_regions(items: list, tolerance: float = 0.0,
         for part in polygon_parts(p, f"region {k}"):
             flat.append(part)
             names.append(f"region {k}")
-    dom = _from_shapely(flat, [], [], [], names, tolerance, keep_collinear)
+    dom = _from_shapely(flat, [], [], [], names, tolerance)
     dom.polygons = polygons
     dom.area = float(sum(p.area for p in polygons))
     return dom
@@ -375,14 +351,21 @@ def polygon_parts(geom, where: str) -> list[Polygon]:
     raise InvalidDomainError(f"{where} is a {geom.geom_type}, expected a Polygon")
 
 
-def to_domain(domain, *, keep_vertices: bool = False, tolerance: float = 0.0) -> Domain:
+def to_domain(domain, *, keep_vertices: bool = False, tolerance: float = 0.0,
+              repair: bool = False) -> Domain:
     """Convert any accepted domain form into a :class:`Domain` (see
     :mod:`aftmesh.domain`).  `keep_vertices` keeps a dict's segments unsplit (the CDT
     splits them exactly); `tolerance` merges vertices closer than it and snaps line
-    ends onto segments that near (0: exact)."""
+    ends onto segments that near (0: exact); `repair` makes invalid polygons valid
+    first (see :mod:`aftmesh.repair`).  What these changed is in ``Domain.report``."""
+    repaired = None
+    if repair:
+        domain, repaired = repair_domain(domain, is_coordinate_array(domain))
     dom = _dispatch(domain, keep_vertices, tolerance)
     if len(dom.vertices):
         check_range(dom.vertices, "vertices")
+    if repaired is not None:
+        dom.report["repair"] = repaired
     return dom
 
 
@@ -392,13 +375,13 @@ def _dispatch(domain, keep_vertices: bool, tolerance: float) -> Domain:
     if isinstance(domain, dict):
         return from_dict(domain, presplit=not keep_vertices)
     if isinstance(domain, shapely.Geometry):
-        return from_geometry(domain, tolerance, keep_vertices)
+        return from_geometry(domain, tolerance)
     if is_coordinate_array(domain):
-        return from_ring(np.asarray(domain, dtype=np.float64), tolerance, keep_vertices)
+        return from_ring(np.asarray(domain, dtype=np.float64), tolerance)
     try:
         items = list(domain)
     except TypeError:
         raise InvalidDomainError(
             f"cannot mesh a {type(domain).__name__}: give a shapely geometry, a sequence of "
             "polygons, an (n, 2) array, a dict or a .poly path") from None
-    return from_regions(items, tolerance, keep_vertices)
+    return from_regions(items, tolerance)

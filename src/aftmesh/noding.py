@@ -42,18 +42,59 @@ def snap_tolerance(pts: np.ndarray) -> float:
     return 2.0 * float(np.spacing(np.abs(pts).max()))
 
 
-def merge_and_node(verts, segs, src, note, ring_source, tolerance: float = 0.0):
+def merge_and_node(verts, segs, src, note, ring_source, tolerance: float = 0.0,
+                   report: dict | None = None):
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
     the outer ring, a T-junction between regions, a constraint line ending on a
     boundary), drop segments given twice (a boundary shared by two regions), and split
-    segments that cross each other at their crossing points."""
+    segments that cross each other at their crossing points.
+
+    With `tolerance` > 0, vertices closer than that are merged first (see
+    :func:`merge_close`) and a line's free end or bend that near a segment splits it
+    there; ``report`` then receives the counts ``merged`` and ``snapped``."""
+    n_merged = 0
+    if tolerance > 0:
+        verts, n_merged = merge_close(verts, tolerance)
+        if n_merged:
+            note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} "
+                        "of another")
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
-    tol = snap_tolerance(uniq)
-    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source)
+    tol = max(snap_tolerance(uniq), tolerance)
+    counts = {"snapped": 0}
+    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    return node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
+    out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
+    if report is not None and tolerance > 0:
+        report.update(merged=n_merged, snapped=counts["snapped"])
+    return out
+
+
+def merge_close(verts: np.ndarray, tolerance: float):
+    """Move every vertex within `tolerance` of another onto the first vertex (in
+    input order: rings before lines before points) of its cluster; clusters are
+    closed under that relation, so a chain of near vertices becomes one.  Returns the
+    new coordinates and how many vertices moved."""
+    if len(verts) < 2:
+        return verts, 0
+    pts = shapely.points(verts)
+    i, j = shapely.STRtree(pts).query(pts, predicate="dwithin", distance=tolerance)
+    pairs = i < j
+    parent = np.arange(len(verts))
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+    for a, b in zip(i[pairs].tolist(), j[pairs].tolist()):
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    rep = np.array([root(v) for v in range(len(verts))])
+    out = verts[rep]
+    return out, int((out != verts).any(axis=1).sum())
 
 
 def _crossing_pairs(verts, segs):
@@ -135,12 +176,13 @@ def _drop_repeats(segs, src):
     return segs[first], src[first]
 
 
-def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None):
+def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None,
+                      counts: dict | None = None):
     """Split each segment at the vertices lying on its interior: exactly (decided with
     the exact orientation predicate), or, for a vertex on no polygon ring (a line's end
     or bend, a lone point), within `tol` of it (see snap_tolerance).  ring_source[s]
     says whether source s is a ring; without it, only vertices with at most one
-    segment are snapped."""
+    segment are snapped.  ``counts['snapped']``, if given, counts the near splits."""
     if len(segs) == 0:
         return segs, src
     segs = np.asarray(segs)
@@ -173,6 +215,8 @@ def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None):
             # that near it, see boundary.discretize).
             if fixed[v]:
                 continue
+            if counts is not None:
+                counts["snapped"] += 1
         cuts.setdefault(k, []).append(v)
     if not cuts:
         return segs, src

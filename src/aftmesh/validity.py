@@ -123,17 +123,17 @@ def _leaves_at(line, union) -> np.ndarray:
     return best if best is not None else shapely.get_coordinates(line)[0]
 
 
-def check_lines_inside(polygons, lines, line_names, points) -> None:
+def check_lines_inside(polygons, lines, line_names, points, tolerance: float = 0.0) -> None:
     """Refuse constraint lines or fixed points outside the domain (a line may stick
-    out by rounding only, see :func:`_outside_by_rounding`)."""
+    out by rounding only, see :func:`_outside_by_rounding`, or by `tolerance`)."""
     union = shapely.union_all(polygons)
     tol = None
     for line, name in zip(lines, line_names):
         if union.covers(line):
             continue
         if tol is None:
-            tol = snap_tolerance(np.concatenate(
-                [shapely.get_coordinates(g) for g in (*polygons, *lines)]))
+            tol = max(tolerance, snap_tolerance(np.concatenate(
+                [shapely.get_coordinates(g) for g in (*polygons, *lines)])))
         if not _outside_by_rounding(line.difference(union), union, tol):
             p = _leaves_at(line, union)
             raise InvalidDomainError(
