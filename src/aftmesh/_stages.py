@@ -21,6 +21,7 @@ from .mesh import Mesh
 from .options import MAX_TRIANGLES, ORDERS, Options
 from .pslg import BuiltCDT, build_cdt
 from .sizing import SizeField, make_size_field, per_region_size
+from .tags import resolve_boundary_tags, segment_tags
 
 # Area of an equilateral triangle of side h, over h^2 (sqrt(3) / 4, rounded as the
 # triangle-count estimate has always used it: the estimate feeds allocation hints).
@@ -243,14 +244,15 @@ def smooth(kernel, boundary: Boundary, rounds: int) -> int:
 
 
 def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Options,
-             moves: int, timing: dict) -> Mesh:
-    """The Mesh: the kernel's compact arrays, each segment's marker (the user's ring
-    / line / segment it lies on, or that source's own marker), and what happened."""
+             moves: int, timing: dict, edge_tags=None) -> Mesh:
+    """The Mesh: the kernel's compact arrays; for each segment its input edge
+    (segment_sources), its marker (the user's ring / line / segment it lies on, or
+    that source's own marker) and its boundary tag; and what happened."""
     built = boundary.built
     a = kernel.arrays()
     to_out = a["vertex_map"][built.merged]
     pieces = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
-    edges = np.where(pieces >= 0, boundary.source[np.maximum(pieces, 0)], -1)
+    edges = np.where(pieces >= 0, boundary.source[np.maximum(pieces, 0)], -1).astype(np.int32)
     markers = np.where(edges >= 0, dom.edge_source[np.maximum(edges, 0)], -1).astype(np.int32)
     if dom.source_markers is not None:
         markers = np.where(markers >= 0, dom.source_markers[np.maximum(markers, 0)], -1)
@@ -269,6 +271,19 @@ def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Op
         "timing": timing,
         **dom.report,
     }
+    tags, names = None, {}
+    if edge_tags is not None:
+        tags, names = segment_tags(edge_tags[0], edges), edge_tags[1]
     return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
                        segments=a["segments"], regions=a["regions"], segment_markers=markers,
-                       info=info)
+                       segment_sources=edges, segment_tags=tags, tag_names=names, info=info)
+
+
+def boundary_tags(dom: Domain, opts: Options):
+    """(tag of each input edge, {name: tag}) from the boundary_tags option, or None.
+    Resolved before any meshing, so a bad selector fails fast."""
+    if opts.boundary_tags is None:
+        return None
+    return resolve_boundary_tags(
+        opts.boundary_tags, dom.edge_midpoints,
+        describe=lambda e: dom.source_names[dom.edge_source[e]])

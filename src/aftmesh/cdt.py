@@ -98,6 +98,8 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
         With segments given, the triangles inside closed rings of segments (minus
         holes); without, the whole convex hull.  ``info['vertex_map']`` maps each
         input vertex to its output index (-1: merged away or outside the domain).
+        ``segment_sources`` (like ``segment_markers`` here) is the index of the input
+        segment each output segment lies on.
 
     Examples
     --------
@@ -117,4 +119,5 @@ def cdt(vertices, segments=None, *, holes=None, regions=None) -> Mesh:
     markers = segment_markers(a["points"], a["segments"], built.vertices, built.segments, to_out)
     info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
     return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
-                segments=a["segments"], regions=a["regions"], segment_markers=markers, info=info)
+                segments=a["segments"], regions=a["regions"], segment_markers=markers,
+                segment_sources=markers, info=info)

@@ -129,6 +129,7 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
                     tolerance=opts.tolerance, repair=opts.repair)
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
+    edge_tags = _stages.boundary_tags(dom, opts)
     field, expected = _stages.size_field(dom, size, opts.gradation)
     t_boundary = time.perf_counter()
     boundary = _stages.boundary_cdt(dom, field, opts, expected)
@@ -139,6 +140,6 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     t_aft = time.perf_counter()
     timing = {"boundary": t_boundary - t_start, "cdt": t_cdt - t_boundary,
               "basic_aft": t_aft - t_cdt}
-    mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing)
+    mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing, edge_tags)
     timing["total"] = time.perf_counter() - t_start
     return mesh
