@@ -107,6 +107,16 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     Returns
     -------
     Mesh
+        With ``segment_sources``: for each segment, the index of the input edge it
+        lies on.  Input edges are numbered as given: for shapely input, polygon by
+        polygon (after a collection's overlapping or edge-sharing polygons are
+        merged by their union), each polygon's exterior ring then its holes, each
+        ring's edges in coordinate order (edge i from coords[i] to coords[i + 1]),
+        then the constraint lines' edges in order; for a sequence of polygons the
+        same, region by region (an edge shared by two regions takes the first
+        one's number); for a dict or ``.poly`` file, the index in ``segments``; for
+        an (n, 2) ring, edge i from vertex i to vertex i + 1.  With ``repair=True``
+        the numbering is that of the repaired polygons.
 
     Examples
     --------
