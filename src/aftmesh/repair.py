@@ -59,11 +59,11 @@ def _repair_collection(domain, report: dict):
         return domain          # nothing to repair; the adapter says what is missing
     union = shapely.union_all(polygons)
     kept = []
-    for k, g in enumerate(others):
+    for g in others:
         if union.covers(g):
             kept.append(g)
         else:
-            report["dropped"].append(f"constraint {g.geom_type} {k} at {_where(g)}: "
+            report["dropped"].append(f"a constraint {g.geom_type} at {_where(g)}: "
                                      "not in or on the repaired domain")
     return GeometryCollection([*polygons, *kept]) if kept else (
         polygons[0] if len(polygons) == 1 else GeometryCollection(polygons))
