@@ -6,10 +6,19 @@ import re
 import numpy as np
 import pytest
 import shapely
-from shapely.geometry import (GeometryCollection, LineString, MultiLineString, Point,
-                              Polygon, box)
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from shapely.geometry import (
+    GeometryCollection,
+    LineString,
+    MultiLineString,
+    Point,
+    Polygon,
+    box,
+)
 
 import aftmesh
+from aftmesh.checks import check_mesh
 from aftmesh.errors import InvalidDomainError, InvalidOptionError
 from aftmesh.mesh import triangle_quality
 
@@ -156,3 +165,45 @@ def test_make_valid_result_is_accepted_with_repair(checked):
     mesh = checked(aftmesh.generate(bad, 0.25, repair=True))
     assert mesh.info["repair"]["repaired"]
     assert abs(mesh.area() - shapely.make_valid(bad).area) < 1e-9
+
+
+# random inputs: any ring of random points is meshable with repair=True, and random
+# nearly meeting constraint lines are with a tolerance
+
+coords = st.integers(0, 20).map(lambda v: v / 20)
+
+
+@settings(max_examples=30)
+@given(st.lists(st.tuples(coords, coords), min_size=4, max_size=9))
+def test_repair_meshes_any_ring_with_area(ring):
+    repaired = shapely.make_valid(Polygon(ring))
+    area = sum(p.area for p in shapely.get_parts(repaired)
+               if p.geom_type in ("Polygon", "MultiPolygon"))
+    if area < 1e-3:
+        with pytest.raises(InvalidDomainError):
+            aftmesh.generate(np.array(ring), 0.1, repair=True)
+        return
+    mesh = aftmesh.generate(np.array(ring), 0.1, repair=True)
+    check_mesh(mesh, domain_area=area)
+    assert mesh.info["repair"]["repaired"] or Polygon(ring).is_valid
+
+
+@settings(max_examples=30)
+@given(st.lists(st.tuples(coords, coords, st.sampled_from([0.0, 1e-13, -7e-13, 2e-12])),
+                min_size=2, max_size=5))
+def test_nearly_meeting_lines_mesh_with_a_tolerance(joints):
+    # a chain of constraint lines inside (0.1, 0.9)^2, each ending a rounding-sized
+    # gap away from where the next begins
+    pts = [(0.1 + 0.8 * x, 0.1 + 0.8 * y, gap) for x, y, gap in joints]
+    lines = []
+    for (xa, ya, _), (xb, yb, gap) in zip(pts[:-1], pts[1:]):
+        if (xa, ya) != (xb, yb):
+            lines.append(LineString([(xa + gap, ya), (xb, yb)]))
+    domain = GeometryCollection([box(0, 0, 1, 1), *lines])
+    mesh = aftmesh.generate(domain, 0.15, tolerance=1e-9)
+    check_mesh(mesh, domain_area=1.0)
+    # no two mesh vertices are closer than the tolerance
+    P = mesh.points
+    d = np.hypot(*(P[:, None, :] - P[None, :, :]).transpose(2, 0, 1))
+    np.fill_diagonal(d, np.inf)
+    assert d.min() > 1e-9

@@ -28,4 +28,4 @@ from .inputs import Domain, to_domain
 from .noding import node_crossings, snap_tolerance
 from .regions import classify_pieces
 
-__all__ = ["Domain", "to_domain", "node_crossings", "snap_tolerance", "classify_pieces"]
+__all__ = ["Domain", "classify_pieces", "node_crossings", "snap_tolerance", "to_domain"]

@@ -21,7 +21,7 @@ from shapely.geometry import (GeometryCollection, LineString, MultiLineString, M
                               MultiPolygon, Point, Polygon)
 
 from .errors import InvalidDomainError, InvalidInputError
-from .noding import merge_and_node, refuse_crossings, snap_tolerance, split_at_vertices
+from .noding import merge_and_node, refuse_crossings, split_at_vertices
 from .pslg import as_points, as_segments, check_range
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon

@@ -13,7 +13,7 @@ import numpy as np
 from .aft import Strategy
 from .errors import InvalidOptionError, InvalidSizeError
 
-__all__ = ["Options", "check_options", "ORDERS", "MAX_SMOOTH", "MAX_TRIANGLES"]
+__all__ = ["MAX_SMOOTH", "MAX_TRIANGLES", "ORDERS", "Options", "check_options"]
 
 # Get_next_edge's orders, as the kernel numbers them
 ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}

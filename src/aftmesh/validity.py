@@ -16,7 +16,7 @@ from shapely.geometry import Polygon
 from .errors import InvalidDomainError
 from .noding import snap_tolerance
 
-__all__ = ["check_polygon", "check_lines_inside"]
+__all__ = ["check_lines_inside", "check_polygon"]
 
 _WHERE = re.compile(r"\[([-+0-9.eEinfa]+) ([-+0-9.eEinfa]+)\]")
 
