@@ -207,3 +207,18 @@ def test_nearly_meeting_lines_mesh_with_a_tolerance(joints):
     d = np.hypot(*(P[:, None, :] - P[None, :, :]).transpose(2, 0, 1))
     np.fill_diagonal(d, np.inf)
     assert d.min() > 1e-9
+
+
+def test_tolerance_on_a_dict_domain_merges_fault_ends(checked):
+    # the square's ring, and two fault segments meant to meet at (1, 1)
+    d = {"vertices": [(0, 0), (2, 0), (2, 2), (0, 2), (0.3, 0.4), (1, 1),
+                      (1 + 1.6e-12, 1), (1.6, 1.5)],
+         "segments": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)],
+         "segment_markers": [1, 1, 1, 1, 2, 3]}
+    exact = checked(aftmesh.generate(d, 0.2), domain_area=4.0)
+    assert triangle_quality(exact.points, exact.triangles)["min_angle"].min() < 1e-3
+    mesh = checked(aftmesh.generate(d, 0.2, tolerance=1e-9), domain_area=4.0)
+    assert mesh.info["tolerance"] == {"merged": 1, "snapped": 0}
+    assert triangle_quality(mesh.points, mesh.triangles)["min_angle"].min() > 15
+    assert sorted(set(mesh.segment_markers.tolist())) == [1, 2, 3]
+    assert sorted(set(mesh.segment_sources.tolist())) == list(range(6))

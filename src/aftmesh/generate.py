@@ -91,10 +91,11 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         invalid polygon raises InvalidDomainError naming the ring at fault.
     tolerance : float
         Absolute distance below which vertices are merged and a constraint line's
-        end or bend is snapped onto a segment it nearly touches (shapely, ring or
-        sequence-of-polygons input); ``info['tolerance']`` counts what it changed
-        (``'merged'``, ``'snapped'``).  Default 0: exact, only exact duplicates
-        merge.  Vertices on a straight run of a ring are kept either way.
+        end or bend (a dict's segment end used by no other segment) is snapped onto a
+        segment it nearly touches; ``info['tolerance']`` counts what it changed
+        (``'merged'``, ``'snapped'``) and ``info['cleanup']`` says so.  Default 0:
+        exact, only exact duplicates merge.  Vertices on a straight run of a ring are
+        kept either way.
     boundary_tags : mapping, optional
         Names for parts of the boundary: ``{name: selector}``, the selector either a
         callable ``f(x, y) -> bool array`` (called once, on the midpoints of all

@@ -21,7 +21,8 @@ from shapely.geometry import (GeometryCollection, LineString, MultiLineString, M
                               MultiPolygon, Point, Polygon)
 
 from .errors import InvalidDomainError, InvalidInputError
-from .noding import merge_and_node, refuse_crossings, split_at_vertices
+from .noding import (merge_and_node, merge_close_segments, refuse_crossings,
+                     split_at_vertices)
 from .pslg import as_points, as_segments, check_range
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
@@ -200,7 +201,7 @@ def _dict_markers(markers, n_segments: int):
     return markers.astype(np.int32)
 
 
-def from_dict(d: dict, presplit: bool = True) -> Domain:
+def from_dict(d: dict, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     """A Triangle-style dict (``vertices``, ``segments``, ``holes``, ``regions``,
     ``segment_markers``): crossings refused, as :func:`aftmesh.cdt` does."""
     if "vertices" not in d:
@@ -210,23 +211,27 @@ def from_dict(d: dict, presplit: bool = True) -> Domain:
     holes = as_points(d.get("holes", np.zeros((0, 2))), "holes")
     reg = _dict_regions(d.get("regions"))
     markers = _dict_markers(d.get("segment_markers"), len(seg))
-    edges = np.arange(len(seg), dtype=np.int32)
-    refuse_crossings(pts, seg)
     names = [f"segments[{i}]" for i in range(len(seg))]
     mids = 0.5 * (pts[seg[:, 0]] + pts[seg[:, 1]])
+    edges = np.arange(len(seg), dtype=np.int32)
+    note: list[str] = []
+    report = {"merged": 0, "snapped": 0}
+    if tolerance > 0:
+        pts, seg, edges, report["merged"] = merge_close_segments(pts, seg, edges, note,
+                                                                 tolerance)
+    refuse_crossings(pts, seg)
     # a segment running exactly through another vertex is split there now, before the
     # size splits it into pieces whose rounded ends would miss that vertex (kept whole,
     # the CDT splits it there exactly, at no cost here)
-    note: list[str] = []
-    if presplit:
-        seg, edges = split_at_vertices(pts, seg, edges, note)
+    if presplit or tolerance > 0:
+        seg, edges = split_at_vertices(pts, seg, edges, note, tolerance, None, report)
     return Domain(pts, np.asarray(seg, dtype=np.int32), np.asarray(edges, dtype=np.int32),
                   np.arange(len(names), dtype=np.int32), names, holes=holes,
                   region_points=reg, source_markers=markers, cleanup=note,
-                  edge_midpoints=mids)
+                  edge_midpoints=mids, report={"tolerance": report} if tolerance > 0 else {})
 
 
-def from_poly_file(path, presplit: bool = True) -> Domain:
+def from_poly_file(path, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     """A Triangle ``.poly`` file: read into a dict, then as :func:`from_dict`."""
     from .io import read_poly
     try:
@@ -234,7 +239,7 @@ def from_poly_file(path, presplit: bool = True) -> Domain:
     except OSError as exc:
         # a wrong path is the caller's input error like any other
         raise InvalidInputError(f"cannot read the domain file {str(path)!r}: {exc}") from None
-    return from_dict(d, presplit)
+    return from_dict(d, presplit, tolerance)
 
 
 def _split_geometry(domain):
@@ -371,9 +376,9 @@ def to_domain(domain, *, keep_vertices: bool = False, tolerance: float = 0.0,
 
 def _dispatch(domain, keep_vertices: bool, tolerance: float) -> Domain:
     if isinstance(domain, (str, PathLike)):
-        return from_poly_file(domain, presplit=not keep_vertices)
+        return from_poly_file(domain, not keep_vertices, tolerance)
     if isinstance(domain, dict):
-        return from_dict(domain, presplit=not keep_vertices)
+        return from_dict(domain, not keep_vertices, tolerance)
     if isinstance(domain, shapely.Geometry):
         return from_geometry(domain, tolerance)
     if is_coordinate_array(domain):

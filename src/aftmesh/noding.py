@@ -97,6 +97,19 @@ def merge_close(verts: np.ndarray, tolerance: float):
     return out, int((out != verts).any(axis=1).sum())
 
 
+def merge_close_segments(pts, segs, src, note, tolerance: float):
+    """A dict's vertices merged within `tolerance` (see :func:`merge_close`), the
+    segments renumbered, those that became points or repeats dropped.  Returns
+    (vertices, segments, src, how many vertices moved)."""
+    moved, n_merged = merge_close(pts, tolerance)
+    if not n_merged:
+        return pts, segs, src, 0
+    note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
+    uniq, inverse = np.unique(moved, axis=0, return_inverse=True)
+    segs, src = _drop_repeats(inverse.reshape(-1)[segs], np.asarray(src))
+    return uniq, segs, src, n_merged
+
+
 def _crossing_pairs(verts, segs):
     lines = shapely.linestrings(np.stack([verts[segs[:, 0]], verts[segs[:, 1]]], axis=1))
     pairs = shapely.STRtree(lines).query(lines, predicate="crosses")

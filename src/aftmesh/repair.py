@@ -13,6 +13,7 @@ import shapely
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
 from .errors import InvalidDomainError
+from .validity import validity_reason
 
 __all__ = ["repair_domain"]
 
@@ -34,7 +35,7 @@ def _polygonal(geom, name: str, report: dict):
     it is recorded in report['dropped']."""
     if geom.is_valid:
         return geom
-    report["repaired"].append(f"{name}: {shapely.is_valid_reason(geom)}")
+    report["repaired"].append(f"{name}: {validity_reason(geom)}")
     fixed = shapely.make_valid(geom)
     polys = []
     for part in shapely.get_parts(fixed):

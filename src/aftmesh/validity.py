@@ -25,7 +25,7 @@ def _xy(x, y) -> str:
     return f"({float(x)!r}, {float(y)!r})"
 
 
-def _reason(geom) -> str:
+def validity_reason(geom) -> str:
     """shapely's validity reason, with its location written as (x, y)."""
     reason = shapely.is_valid_reason(geom)
     return _WHERE.sub(lambda m: " at " + _xy(m.group(1), m.group(2)), reason)
@@ -48,7 +48,7 @@ def _hole_problems(poly: Polygon) -> list[str]:
     holes = [Polygon(h) for h in poly.interiors]
     for k, hole in enumerate(holes):
         if not hole.is_valid:
-            problems.append(f"hole {k}: {_reason(hole)}")
+            problems.append(f"hole {k}: {validity_reason(hole)}")
         elif outer.is_valid and not outer.contains(hole):
             p = hole.difference(outer).representative_point()
             problems.append(f"hole {k} is not inside the exterior ring (at {_xy(*p.coords[0])})")
@@ -81,10 +81,10 @@ def check_polygon(poly: Polygon, where: str) -> None:
         problems = []
         outer = Polygon(poly.exterior)
         if not outer.is_valid:
-            problems.append(f"the exterior ring: {_reason(outer)}")
+            problems.append(f"the exterior ring: {validity_reason(outer)}")
         problems += _hole_problems(poly)
         if not problems:
-            problems.append(f"its rings: {_reason(poly)}")
+            problems.append(f"its rings: {validity_reason(poly)}")
         raise InvalidDomainError(f"{where} is not a valid polygon: " + "; ".join(problems))
     if not poly.area > 0:
         coords = np.asarray(poly.exterior.coords)
