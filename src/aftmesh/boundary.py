@@ -12,7 +12,12 @@ import numpy as np
 
 from .sizing import SizeField
 
-_SAMPLES = 32  # points per segment at which the size is read to integrate 1/h
+# Points per segment at which the size is read to integrate 1/h: the size field is a
+# graded grid, so 31 intervals follow it closely along any one input edge.
+_SAMPLES = 32
+# Below this relative difference of h between two samples, 1/h is integrated as the
+# mean of the ends (the exact log formula would divide by nearly zero).
+_FLAT = 1e-9
 
 
 def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
@@ -46,7 +51,7 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     h0 = h[:, :-1]
     h1 = h[:, 1:]
     with np.errstate(divide="ignore", invalid="ignore"):
-        log_mean = np.where(np.abs(h1 - h0) > 1e-9 * h0, (np.log(h1) - np.log(h0)) / (h1 - h0),
+        log_mean = np.where(np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0),
                             2.0 / (h0 + h1))
     steps = ds * log_mean
     cum = np.concatenate([np.zeros((len(segments), 1)), np.cumsum(steps, axis=1)], axis=1)

@@ -48,8 +48,9 @@ def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise")
         With segments given, the triangles inside closed rings of segments (minus
         holes); without, the whole convex hull.  ``info['vertex_map']`` maps each
         input vertex to its output index (-1: merged away or outside the domain).
-        ``segment_markers`` gives, for each output segment, the input segment it is a
-        piece of (the kernel carries it through every split and retriangulation).
+        ``segment_markers`` and ``segment_sources`` give, for each output segment, the
+        input segment it is a piece of (the kernel carries it through every split and
+        retriangulation).
 
     Examples
     --------
@@ -96,7 +97,7 @@ def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise")
                 "crossings": _crossing_report(verts, segs, src, to_noded, noded_out)}
     return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
                        segments=a["segments"], regions=a["regions"], segment_markers=markers,
-                       info=info)
+                       segment_sources=markers, info=info)
 
 
 def _split_crossings(vertices, segments):

@@ -7,37 +7,19 @@ from typing import Any
 
 import numpy as np
 
+from .errors import InvalidOptionError
+from .quality import triangle_quality
+
 __all__ = ["Mesh", "triangle_quality"]
+
+# Per-segment int32 arrays a Mesh may carry (None when its maker has none).
+_OPTIONAL_SEGMENT_ARRAYS = ("segment_sources", "segment_tags")
 
 
 def _frozen(a, dtype) -> np.ndarray:
     arr = np.array(a, dtype=dtype, copy=True)
     arr.setflags(write=False)
     return arr
-
-
-def triangle_quality(points: np.ndarray, triangles: np.ndarray) -> dict[str, np.ndarray]:
-    """Per-triangle shape measures.
-
-    Returns a dict of arrays: ``radius_ratio`` (2 r_in / r_circ: 1 for an equilateral
-    triangle, 0 for a degenerate one), ``min_angle`` and ``max_angle`` in degrees,
-    ``area``, and ``edge_lengths`` (t, 3) with column k the edge opposite vertex k.
-    """
-    p = points[triangles]
-    e = np.stack([p[:, 2] - p[:, 1], p[:, 0] - p[:, 2], p[:, 1] - p[:, 0]], axis=1)
-    lengths = np.linalg.norm(e, axis=2)
-    a, b, c = lengths[:, 0], lengths[:, 1], lengths[:, 2]
-    area = 0.5 * (e[:, 2, 0] * (-e[:, 1, 1]) - e[:, 2, 1] * (-e[:, 1, 0]))
-    perimeter = a + b + c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # 2 r_in / r_circ = 16 area^2 / (perimeter a b c)
-        rr = np.where(area > 0, 16.0 * area * area / (perimeter * a * b * c), 0.0)
-        cos = np.stack([(b * b + c * c - a * a) / (2 * b * c),
-                        (c * c + a * a - b * b) / (2 * c * a),
-                        (a * a + b * b - c * c) / (2 * a * b)], axis=1)
-    ang = np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), -1.0, 1.0)))
-    return dict(radius_ratio=rr, min_angle=ang.min(axis=1), max_angle=ang.max(axis=1),
-                area=area, edge_lengths=lengths)
 
 
 @dataclass(frozen=True, repr=False, eq=False)
@@ -56,9 +38,18 @@ class Mesh:
     segments : (s, 2) int32
         The constrained edges (input edges and the pieces they were split into).
     segment_markers : (s,) int32
-        For each segment, the input segment (or ring edge) it came from, -1 if unknown.
+        For each segment, the input ring / constraint line / segment it came from (or
+        that segment's own marker, for a dict input that has them), -1 if unknown.
     regions : (t,) int32
         Region marker of each triangle.
+    segment_sources : (s,) int32 or None
+        For each segment, the index of the user's input edge it lies on, -1 if none
+        (numbering: see :func:`aftmesh.generate`).
+    segment_tags : (s,) int32 or None
+        For each segment, the number of its named boundary part (``boundary_tags``
+        of :func:`aftmesh.generate`), 0 if untagged.
+    tag_names : dict
+        Name -> tag number of the named boundary parts.
     info : dict
         What happened on the way: merged vertices, counters, timings.
     """
@@ -70,6 +61,9 @@ class Mesh:
     regions: np.ndarray
     segment_markers: np.ndarray | None = None
     info: dict[str, Any] = field(default_factory=dict)
+    segment_sources: np.ndarray | None = None
+    segment_tags: np.ndarray | None = None
+    tag_names: dict[str, int] = field(default_factory=dict)
 
     def __post_init__(self):
         object.__setattr__(self, "points", _frozen(self.points, np.float64).reshape(-1, 2))
@@ -81,6 +75,11 @@ class Mesh:
         if markers is None:
             markers = np.full(len(self.segments), -1, dtype=np.int32)
         object.__setattr__(self, "segment_markers", _frozen(markers, np.int32).reshape(-1))
+        for name in _OPTIONAL_SEGMENT_ARRAYS:
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, _frozen(value, np.int32).reshape(-1))
+        object.__setattr__(self, "tag_names", dict(self.tag_names or {}))
 
     @classmethod
     def _adopt(cls, **arrays) -> "Mesh":
@@ -94,8 +93,44 @@ class Mesh:
             arr = np.ascontiguousarray(arrays[name], dtype=dtype)
             arr.setflags(write=False)
             object.__setattr__(mesh, name, arr)
+        for name in _OPTIONAL_SEGMENT_ARRAYS:
+            value = arrays.get(name)
+            if value is not None:
+                value = np.ascontiguousarray(value, dtype=np.int32)
+                value.setflags(write=False)
+            object.__setattr__(mesh, name, value)
+        object.__setattr__(mesh, "tag_names", dict(arrays.get("tag_names") or {}))
         object.__setattr__(mesh, "info", arrays.get("info", {}))
         return mesh
+
+    def boundary_facets(self, tag) -> np.ndarray:
+        """Indices into ``segments`` of one tagged boundary part.
+
+        Parameters
+        ----------
+        tag : str or int
+            A name from ``tag_names`` (the segments whose ``segment_tags`` is its
+            number) or an integer (the segments whose ``segment_markers`` equal it).
+
+        Examples
+        --------
+        >>> import aftmesh
+        >>> from shapely.geometry import box
+        >>> m = aftmesh.generate(box(0, 0, 2, 1), 0.25,
+        ...                      boundary_tags={"left": lambda x, y: x == 0})
+        >>> left = m.boundary_facets("left")
+        >>> bool((m.points[m.segments[left]][..., 0] == 0).all()), len(left)
+        (True, 4)
+        """
+        if isinstance(tag, str):
+            if tag not in self.tag_names or self.segment_tags is None:
+                raise InvalidOptionError(
+                    f"no boundary part named {tag!r}: the names are {sorted(self.tag_names)}")
+            return np.flatnonzero(self.segment_tags == self.tag_names[tag])
+        if isinstance(tag, (bool, np.bool_)) or not isinstance(tag, (int, np.integer)):
+            raise InvalidOptionError(
+                f"tag must be a name from tag_names or an integer marker, got {tag!r}")
+        return np.flatnonzero(self.segment_markers == tag)
 
     @property
     def n_points(self) -> int:

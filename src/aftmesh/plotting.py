@@ -9,7 +9,7 @@ from os import PathLike
 import numpy as np
 
 from .errors import InvalidOptionError
-from .mesh import triangle_quality
+from .quality import triangle_quality
 
 __all__ = ["plot_mesh", "save_png"]
 

@@ -1,7 +1,8 @@
 """Size specifications -> the compiled size field (a background grid).
 
 A user's ``size`` is a number (the target edge length everywhere), a callable
-``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point), or
+``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point: x
+and y are 1-D arrays of equal length, the result one size per point or a scalar), or
 ``None`` (sizes taken from the lengths of the boundary's own edges and spread inward).
 Whatever it is, it becomes a regular grid of target lengths that the kernel
 interpolates bilinearly, after a gradation limit has been applied so that the size
@@ -30,6 +31,19 @@ MIN_SIZE_ULPS = 64
 # How far (in its own edge lengths) a boundary edge's length holds as the size before
 # it grows at the gradation rate (see make_size_field).
 BOUNDARY_REACH = 10.0
+# A constant size needs no grid when no input edge is shorter than this fraction of
+# it: the discretization rounds the number of pieces, so edges a little shorter than
+# the size are met anyway.
+CONSTANT_IF_EDGES_ABOVE = 0.8
+# The grid reaches this fraction of the domain's span beyond its bounding box, so
+# points proposed just outside an edge still read a size from inside the grid.
+GRID_PAD = 0.02
+# The coarsest grid spacing, as a fraction of the domain's span: finer features of a
+# size callable than that are not seen by the first, coarse look.
+COARSE_CELLS = 64
+# The grid spacing is at most this fraction of the smallest size it must resolve
+# (two nodes per size: bilinear interpolation then follows it closely).
+NODES_PER_SIZE = 0.5
 
 
 @dataclass(frozen=True)
@@ -90,16 +104,29 @@ def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
 
 
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """The user's size at the grid nodes, in one call: ``size(x, y)`` with x and y
+    1-D arrays of equal length (the nodes row by row), returning that many sizes or
+    one number.  1-D because that is what point-based tools take (``np.c_[x, y]``,
+    KD-trees, interpolators, ``shapely.distance`` of points)."""
+    x = np.ascontiguousarray(X, dtype=np.float64).reshape(-1)
+    y = np.ascontiguousarray(Y, dtype=np.float64).reshape(-1)
     try:
-        out = size(X, Y)
+        out = size(x, y)
     except Exception as exc:  # the user's function failed: say so, keep the cause
         raise InvalidSizeError(f"the size callable raised {type(exc).__name__}: {exc}") from exc
     try:
-        h = np.broadcast_to(np.asarray(out, dtype=np.float64), X.shape).copy()
+        values = np.asarray(out, dtype=np.float64)
     except (TypeError, ValueError) as exc:
+        raise InvalidSizeError(f"the size callable must return numbers: {exc}") from None
+    if values.ndim == 0:
+        h = np.full(X.shape, float(values))
+    elif values.shape == x.shape:
+        h = values.reshape(X.shape).copy()
+    else:
         raise InvalidSizeError(
-            f"the size callable must return numbers broadcastable to shape {X.shape} "
-            f"(it is called with two arrays): {exc}") from None
+            f"the size callable returned an array of shape {values.shape}: it is called "
+            f"with 1-D arrays x, y of length {len(x)} and must return an array of that "
+            "length (one size per point) or a single number")
     _check_values(h, X, Y, "the size callable")
     return h
 
@@ -204,24 +231,24 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
         _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
     if constant is not None and (not have_boundary
-                                 or float(np.min(boundary_lengths)) >= 0.8 * constant):
+                                 or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant):
         # the boundary asks for nothing smaller: a constant needs no grid
         return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[constant]]))
     if size is None and not have_boundary:
         raise InvalidSizeError("size=None takes the size from the input edges, but there are none")
     (xmin, ymin), (xmax, ymax) = bounds
     span = max(xmax - xmin, ymax - ymin)
-    pad = 0.02 * span
+    pad = GRID_PAD * span
     bounds = ((xmin - pad, ymin - pad), (xmax + pad, ymax + pad))
-    spacing = span / 64
+    spacing = span / COARSE_CELLS
     if have_boundary:
-        spacing = min(spacing, 0.5 * float(np.min(boundary_lengths)))
+        spacing = min(spacing, NODES_PER_SIZE * float(np.min(boundary_lengths)))
     if callable(size):
         # a coarse look first, to pick a grid spacing fine enough for the smallest size
-        x0, y0, dx, dy, X, Y = _grid(bounds, span / 64)
+        x0, y0, dx, dy, X, Y = _grid(bounds, span / COARSE_CELLS)
         h0 = _evaluate(size, X, Y)
         _check_resolution(h0, X, Y, bounds, "the size callable gave")
-        spacing = min(spacing, 0.5 * float(h0.min()))
+        spacing = min(spacing, NODES_PER_SIZE * float(h0.min()))
     x0, y0, dx, dy, X, Y = _grid(bounds, spacing)
     if callable(size):
         h = _evaluate(size, X, Y)
@@ -242,8 +269,8 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
         # gradation rate beyond (not the bare length at any distance: a cell can be
         # far larger than a tiny edge, and bilinear interpolation would spread that
         # tiny size over the whole cell; nor growing from the vertex itself: the
-        # field would then miss the boundary's sizes next to it, and on the graded
-        # naca0012 benchmark the mean radius ratio fell from 0.962 to 0.940)
+        # field would then be larger than the boundary's edges right next to them,
+        # and the first layer of triangles on a graded boundary would be stretched)
         rate = spread - 1.0
         i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
         j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)

@@ -1,0 +1,287 @@
+"""The stages of one :func:`aftmesh.generate` call, in the order it runs them.
+
+Each stage is one step of ARCHITECTURE.md's data flow: the size field, the discretized
+boundary and its CDT (with the retry policy for rounding), the kernel made ready for
+the front, the front itself, smoothing, and the :class:`~aftmesh.mesh.Mesh`.
+"""
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+
+import numpy as np
+
+from .aft import basic_aft
+from .boundary import discretize
+from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
+from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
+                     InvalidSizeError)
+from .mesh import Mesh
+from .options import MAX_TRIANGLES, ORDERS, Options
+from .pslg import BuiltCDT, build_cdt
+from .sizing import SizeField, make_size_field, per_region_size
+from .tags import resolve_boundary_tags, segment_tags
+
+# Area of an equilateral triangle of side h, over h^2 (sqrt(3) / 4, rounded as the
+# triangle-count estimate has always used it: the estimate feeds allocation hints).
+EQUILATERAL_AREA = 0.43
+# The count estimate's smallest growth rate: with no gradation limit the graded-disk
+# bound of _expected_triangles would be infinite.
+MIN_ESTIMATE_RATE = 0.05
+# The estimate is rough; overshooting it a little costs less than regrowing arrays.
+ESTIMATE_MARGIN = 1.2
+# The triangle-count hint stays below what int32 half-edge indices (3 per triangle)
+# can number.
+MAX_TRIANGLE_HINT = 4e8
+# Up-front allocation is capped: arrays grow by doubling anyway, and an overestimate
+# must not reserve gigabytes before the first triangle.
+MAX_PREALLOCATED = 50_000_000
+# A progress bar is worth drawing only for meshes that take seconds.
+PROGRESS_MIN_TRIANGLES = 200_000
+# Default A_min (formula (5)): this fraction of the smallest size's equilateral
+# triangle, small enough never to refuse a point the size asks for.
+MIN_AREA_FRACTION = 0.01
+
+
+class _ProgressBar:
+    """A one-line bar on standard error, redrawn only when the percentage changes."""
+
+    WIDTH = 30
+
+    def __init__(self, stream):
+        self.stream = stream
+        self.last = -1
+
+    def __call__(self, fraction: float) -> None:
+        pct = int(100 * min(max(fraction, 0.0), 1.0))
+        if pct != self.last:
+            self.last = pct
+            filled = pct * self.WIDTH // 100
+            bar = "#" * filled + "." * (self.WIDTH - filled)
+            self.stream.write(f"\raftmesh [{bar}] {pct:3d}%")
+            self.stream.flush()
+
+    def close(self) -> None:
+        if self.last >= 0:
+            self.stream.write("\r" + " " * (self.WIDTH + 18) + "\r")
+            self.stream.flush()
+
+
+def _progress_callback(progress, expected_triangles: int):
+    if callable(progress):
+        return progress
+    if progress is None:
+        progress = sys.stderr.isatty() and expected_triangles > PROGRESS_MIN_TRIANGLES
+    return _ProgressBar(sys.stderr) if progress else None
+
+
+def expected_triangles(field: SizeField, area: float, gradation: float) -> float:
+    """About how many triangles the size field asks for on `area`.  On a grid, a
+    node's cell is counted at most as a graded disk around a tiny size would be (the
+    count around a point where h grows linearly from h0 is only logarithmic in 1/h0),
+    so one tiny feature does not make the estimate explode."""
+    with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
+        if field.h.size == 1:
+            return float(np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min))
+                         / field.h_min)
+        h = field.h
+        rate = max(gradation - 1.0, MIN_ESTIMATE_RATE)
+        cell = field.dx * field.dy
+        dense = cell / (EQUILATERAL_AREA * h) / h
+        graded = (2 * np.pi / (EQUILATERAL_AREA * rate * rate)) * (
+            1.0 + np.log1p(rate * max(field.dx, field.dy) / h))
+        grid_area = cell * h.size
+        return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area)
+                     * ESTIMATE_MARGIN)
+
+
+def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
+    """The size field over the domain, and the number of triangles it asks for.
+
+    The user's size is combined with the shortest input edge at each vertex: the size
+    never asks for more than that edge there."""
+    if isinstance(size, np.ndarray) and size.ndim == 0:
+        size = size.item()
+    lo = dom.vertices.min(axis=0)
+    hi = dom.vertices.max(axis=0)
+    if isinstance(size, (list, tuple, np.ndarray)):
+        if dom.polygons is None:
+            raise InvalidSizeError("a list of sizes needs a list of region polygons as the domain")
+        size = per_region_size(dom.polygons, size)
+    seg = dom.segments
+    if len(seg):
+        lengths = np.linalg.norm(dom.vertices[seg[:, 1]] - dom.vertices[seg[:, 0]], axis=1)
+        shortest = np.full(len(dom.vertices), np.inf)
+        np.minimum.at(shortest, seg[:, 0], lengths)
+        np.minimum.at(shortest, seg[:, 1], lengths)
+        used = np.isfinite(shortest)
+        field = make_size_field(size, (lo, hi), dom.vertices[used], shortest[used], gradation)
+    else:
+        field = make_size_field(size, (lo, hi), gradation=gradation)
+    area = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
+    expected = expected_triangles(field, area, gradation)
+    if not expected <= MAX_TRIANGLES:
+        raise InvalidSizeError(
+            f"the size (down to {field.h_min:.3g}) asks for about {expected:.3g} triangles "
+            f"on a domain of area {area:.3g}: more than the {MAX_TRIANGLES} aftmesh "
+            "can number")
+    return field, expected
+
+
+@dataclass
+class Boundary:
+    """The discretized boundary and the kernel holding its CDT."""
+
+    built: BuiltCDT
+    vertices: np.ndarray
+    segments: np.ndarray
+    source: np.ndarray          # input edge of each segment (see Domain.segment_edge)
+    triangle_hint: int
+
+
+def _name_sources(err: CrossingSegmentsError, dom: Domain, verts, segs, edge):
+    """The same error naming the user's segments / rings, not the pieces the
+    discretization made of them."""
+    src = dom.edge_source[edge]
+    names = [dom.source_names[src[k]] for k in err.segments if 0 <= k < len(src)]
+    where = [verts[segs[k]].tolist() for k in err.segments if 0 <= k < len(src)]
+    detail = " and ".join(f"{n} (near {w[0]} -> {w[1]})" for n, w in zip(names, where))
+    return CrossingSegmentsError(f"these input edges cross: {detail}",
+                                 tuple(int(src[k]) for k in err.segments))
+
+
+def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) -> Boundary:
+    """Split the input edges by the size and build their CDT in the kernel.
+
+    The domain's edges were noded before the discretization (and a dict's crossings
+    refused), so a crossing now, or a piece running exactly through another vertex,
+    comes from a rounded split point put on or across a segment passing within an
+    ulp or two of it: then discretize again without such points.  What still crosses
+    after that does so by the rounding of the pieces themselves (two segments apart
+    only at a grazing angle): node those pieces too, and try once more."""
+    if opts.split_boundary:
+        # a triangle has three sides, so more boundary edges than 3 N_max can never
+        # be meshed within N_max: refuse before allocating them (the exact minimum,
+        # formula (3), is checked once the CDT exists)
+        cap, limit = opts.triangle_cap
+        verts, segs, edge = discretize(dom.vertices, dom.segments, dom.segment_edge, field,
+                                       max_pieces=3 * cap, limit=limit)
+    else:
+        verts, segs, edge = dom.vertices, dom.segments, dom.segment_edge
+    hint = int(min(MAX_TRIANGLE_HINT, expected + 4 * len(verts)))
+
+    def build(verts, segs):
+        try:
+            return build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
+                             nt_hint=min(hint, MAX_PREALLOCATED))
+        except CrossingSegmentsError as err:
+            return err
+
+    built = build(verts, segs)
+    if opts.split_boundary and (isinstance(built, CrossingSegmentsError) or built.n_split):
+        verts, segs, edge = discretize(dom.vertices, dom.segments, dom.segment_edge, field,
+                                       clear=snap_tolerance(dom.vertices))
+        dom.cleanup.append("left out split points within rounding of other segments")
+        built = build(verts, segs)
+    if isinstance(built, CrossingSegmentsError):
+        verts, segs, edge = node_crossings(verts, segs, edge, dom.cleanup,
+                                           ring_source=dom.edge_is_ring)
+        built = build(verts, segs)
+        if isinstance(built, CrossingSegmentsError):
+            raise _name_sources(built, dom, verts, segs, edge) from None
+    return Boundary(built, verts, segs, edge, hint)
+
+
+def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Options):
+    """Give the CDT's pieces their regions, check the domain has area and fits
+    max_triangles, and hand the size grid and options to the kernel."""
+    kernel = boundary.built.kernel
+    if dom.polygons is not None:
+        comp, probes, corners = kernel.components()
+        kernel.set_regions(comp, classify_pieces(dom.polygons, probes, corners))
+    _, n_unmeshed, _ = kernel.state_counts()
+    if n_unmeshed == 0:
+        raise InvalidDomainError(
+            "the domain encloses no area (are the segments closed rings? are all regions holes?)")
+    if opts.max_triangles is not None and n_unmeshed > opts.max_triangles:
+        raise InvalidSizeError(
+            f"max_triangles={opts.max_triangles} is below the {n_unmeshed} triangles any "
+            "triangulation of this boundary needs (formula (3))")
+    min_area = opts.min_area
+    if min_area is None:
+        min_area = MIN_AREA_FRACTION * (np.sqrt(3) / 4) * field.h_min ** 2
+    kernel.set_size_grid(field.x0, field.y0, field.dx, field.dy, field.h)
+    kernel.set_options(order=ORDERS[opts.order],
+                       max_triangles=-1 if opts.max_triangles is None else opts.max_triangles,
+                       min_area=float(min_area), close_factor=opts.close_factor,
+                       swaps=opts.swaps, greedy=opts.greedy)
+    return kernel
+
+
+def run_front(kernel, opts: Options, triangle_hint: int) -> None:
+    """Basic_aft until the front is empty: the compiled loop without the GIL, or the
+    Python loop when the strategy overrides a subtask."""
+    if opts.compiled:
+        kernel.convert_to_frontal_edge_set()
+        bar = _progress_callback(opts.progress, triangle_hint)
+        try:
+            kernel.run(progress=bar)
+        finally:
+            if isinstance(bar, _ProgressBar):
+                bar.close()
+        return
+    basic_aft(kernel, opts.strategy)
+    if kernel.counters()["unmeshed"] != 0:
+        raise InvalidOptionError(
+            "the strategy's get_next_edge returned -1 while front edges remained")
+
+
+def smooth(kernel, boundary: Boundary, rounds: int) -> int:
+    """Smoothing rounds after the front has closed; the number of vertex moves.  The
+    vertices of the discretized boundary (numbered first) never move."""
+    return kernel.smooth(len(boundary.vertices), rounds) if rounds else 0
+
+
+def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Options,
+             moves: int, timing: dict, edge_tags=None) -> Mesh:
+    """The Mesh: the kernel's compact arrays; for each segment its input edge
+    (segment_sources), its marker (the user's ring / line / segment it lies on, or
+    that source's own marker) and its boundary tag; and what happened."""
+    built = boundary.built
+    a = kernel.arrays()
+    pieces = a["segment_ids"]     # the kernel's provenance of each output segment
+    edges = np.where(pieces >= 0, boundary.source[np.maximum(pieces, 0)], -1).astype(np.int32)
+    markers = np.where(edges >= 0, dom.edge_source[np.maximum(edges, 0)], -1).astype(np.int32)
+    if dom.source_markers is not None:
+        markers = np.where(markers >= 0, dom.source_markers[np.maximum(markers, 0)], -1)
+    counters = kernel.counters()
+    info = {
+        "merged_vertices": built.n_merged,
+        "cleanup": dom.cleanup,
+        "sources": dom.source_names,
+        "new_vertices": counters["new_vertices"],
+        # Update_internal calls where T(E, R) was not already a CDT triangle after
+        # inserting R, so F and G were inserted by retriangulation (Lemma 3.1 says 0)
+        "forced_edges": counters["forced_edges"],
+        "smoothing_moves": moves,
+        "compiled_loop": opts.compiled,
+        "size_field": field,
+        "timing": timing,
+        **dom.report,
+    }
+    tags, names = None, {}
+    if edge_tags is not None:
+        tags, names = segment_tags(edge_tags[0], edges), edge_tags[1]
+    return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
+                       segments=a["segments"], regions=a["regions"], segment_markers=markers,
+                       segment_sources=edges, segment_tags=tags, tag_names=names, info=info)
+
+
+def boundary_tags(dom: Domain, opts: Options):
+    """(tag of each input edge, {name: tag}) from the boundary_tags option, or None.
+    Resolved before any meshing, so a bad selector fails fast."""
+    if opts.boundary_tags is None:
+        return None
+    return resolve_boundary_tags(
+        opts.boundary_tags, dom.edge_midpoints,
+        describe=lambda e: dom.source_names[dom.edge_source[e]])

@@ -1,0 +1,254 @@
+"""Noding and repair of a planar straight-line graph (PSLG).
+
+The input adapters (:mod:`aftmesh.inputs`) hand over rings and lines as vertices and
+segments; this module makes them a proper PSLG: coincident vertices merged, every
+segment split at the vertices lying on it (exactly, or within rounding for a line's
+free end, see :func:`snap_tolerance`), segments given twice dropped, and crossings
+noded.  Each segment carries ``src``, the index of the input edge it is a piece of, so
+every piece can be traced back to what the user drew.
+"""
+from __future__ import annotations
+
+import numpy as np
+import shapely
+from shapely.geometry import Point
+
+from ._kernel import py_orient2d
+from .errors import CrossingSegmentsError
+
+__all__ = ["snap_tolerance", "merge_and_node", "node_crossings", "split_at_vertices",
+           "refuse_crossings"]
+
+# Segments still crossing after this many rounds of noding are left for the CDT to
+# report: each round only bends pieces by an ulp, so one or two rounds suffice.
+NODING_ROUNDS = 8
+# Relative reach of the candidate search for vertices on segments: shapely's own
+# point-on-line test may miss a point exactly on a segment but not representable on
+# its line, so candidates are gathered this near and then decided exactly.
+CANDIDATE_REACH = 1e-12
+
+
+def snap_tolerance(pts: np.ndarray) -> float:
+    """How near a vertex must be to a segment to count as lying on it: two units in
+    the last place (ulps) of the largest coordinate.  Points computed from the input (a
+    line's end at a + t (b - a), a crossing point, the points that split an edge for
+    the size) are off by up to about one such unit, so a vertex that near an edge may
+    land on either side of it or of the pieces it is split into; splitting the edge at
+    the vertex bends it by no more than that and removes the ambiguity.  (Larger, it
+    would close gaps a valid polygon has on purpose; what it leaves, generate repairs
+    after the discretization.)"""
+    if len(pts) == 0:
+        return 0.0
+    return 2.0 * float(np.spacing(np.abs(pts).max()))
+
+
+def merge_and_node(verts, segs, src, note, ring_source, tolerance: float = 0.0,
+                   report: dict | None = None):
+    """Make the input edges a proper PSLG: merge coincident vertices, split every
+    segment at the input vertices lying on it or within rounding of it (a hole touching
+    the outer ring, a T-junction between regions, a constraint line ending on a
+    boundary), drop segments given twice (a boundary shared by two regions), and split
+    segments that cross each other at their crossing points.
+
+    With `tolerance` > 0, vertices closer than that are merged first (see
+    :func:`merge_close`) and a line's free end or bend that near a segment splits it
+    there; ``report`` then receives the counts ``merged`` and ``snapped``."""
+    n_merged = 0
+    if tolerance > 0:
+        verts, n_merged = merge_close(verts, tolerance)
+        if n_merged:
+            note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} "
+                        "of another")
+    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
+    segs = inverse.reshape(-1)[segs]
+    tol = max(snap_tolerance(uniq), tolerance)
+    counts = {"snapped": 0}
+    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
+    segs, src = _drop_repeats(segs, src)
+    out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
+    if report is not None and tolerance > 0:
+        report.update(merged=n_merged, snapped=counts["snapped"])
+    return out
+
+
+def merge_close(verts: np.ndarray, tolerance: float):
+    """Move every vertex within `tolerance` of another onto the first vertex (in
+    input order: rings before lines before points) of its cluster; clusters are
+    closed under that relation, so a chain of near vertices becomes one.  Returns the
+    new coordinates and how many vertices moved."""
+    if len(verts) < 2:
+        return verts, 0
+    pts = shapely.points(verts)
+    i, j = shapely.STRtree(pts).query(pts, predicate="dwithin", distance=tolerance)
+    pairs = i < j
+    parent = np.arange(len(verts))
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+    for a, b in zip(i[pairs].tolist(), j[pairs].tolist()):
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[max(ra, rb)] = min(ra, rb)
+    rep = np.array([root(v) for v in range(len(verts))])
+    out = verts[rep]
+    return out, int((out != verts).any(axis=1).sum())
+
+
+def merge_close_segments(pts, segs, src, note, tolerance: float):
+    """A dict's vertices merged within `tolerance` (see :func:`merge_close`), the
+    segments renumbered, those that became points or repeats dropped.  Returns
+    (vertices, segments, src, how many vertices moved)."""
+    moved, n_merged = merge_close(pts, tolerance)
+    if not n_merged:
+        return pts, segs, src, 0
+    note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
+    uniq, inverse = np.unique(moved, axis=0, return_inverse=True)
+    segs, src = _drop_repeats(inverse.reshape(-1)[segs], np.asarray(src))
+    return uniq, segs, src, n_merged
+
+
+def _crossing_pairs(verts, segs):
+    lines = shapely.linestrings(np.stack([verts[segs[:, 0]], verts[segs[:, 1]]], axis=1))
+    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
+    return lines, pairs[:, pairs[0] < pairs[1]]
+
+
+def node_crossings(verts, segs, src, note, tol=None, rounds: int = NODING_ROUNDS, ring_source=None):
+    """Split the segments that cross each other at their crossing points, until none
+    cross.  A crossing point is rounded, so it is not exactly on either segment, but
+    within an ulp of both: the two pieces of each segment bend by that much at most,
+    and a bent piece may, rarely, cross another segment that passes just as near; so
+    this repeats (a few rounds at most in practice).  Returns (vertices, segments,
+    source); segments still crossing after `rounds` rounds are left for the CDT to
+    report."""
+    if tol is None:
+        tol = snap_tolerance(verts)
+    n_cut = 0
+    for _ in range(rounds):
+        if len(segs) < 2:
+            break
+        lines, pairs = _crossing_pairs(verts, segs)
+        if pairs.shape[1] == 0:
+            break
+        base = len(verts)
+        extra = []
+        cuts: dict[int, list[int]] = {}
+        for i, j in pairs.T:
+            for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
+                if isinstance(p, Point):
+                    extra.append(np.asarray(p.coords)[0, :2])
+                    cuts.setdefault(int(i), []).append(base + len(extra) - 1)
+                    cuts.setdefault(int(j), []).append(base + len(extra) - 1)
+        if not extra:
+            break
+        n_cut += pairs.shape[1]
+        verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
+        segs, src = _cut(verts, segs, src, cuts)
+        verts, inverse = np.unique(verts, axis=0, return_inverse=True)
+        segs = inverse.reshape(-1)[segs]
+        segs, src = split_at_vertices(verts, segs, src, None, tol, ring_source)
+        segs, src = _drop_repeats(segs, src)
+    if n_cut and note is not None:
+        note.append(f"split segments at {n_cut} crossings")
+    return verts, segs, src
+
+
+def _cut(pts, segs, src, cuts):
+    """Replace each segment k in `cuts` by the chain through the vertices cuts[k],
+    ordered along it."""
+    out_s, out_src = [], []
+    for k in range(len(segs)):
+        if k not in cuts:
+            out_s.append(segs[k][None, :])
+            out_src.append([src[k]])
+            continue
+        a, b = segs[k]
+        # order the cut points along the segment by the coordinate along which it runs
+        # furthest, then the other: comparing coordinates is exact, whereas a dot
+        # product would round away the order of points closer than its ulp
+        d = pts[b] - pts[a]
+        major = 0 if abs(d[0]) >= abs(d[1]) else 1
+        sign = np.where(d >= 0, 1.0, -1.0)
+        inner = sorted(set(cuts[k]) - {a, b},
+                       key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]))
+        chain = [a, *inner, b]
+        out_s.append(np.c_[chain[:-1], chain[1:]])
+        out_src.append([src[k]] * (len(chain) - 1))
+    return (np.concatenate(out_s).astype(np.int64),
+            np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64))
+
+
+def _drop_repeats(segs, src):
+    key = np.sort(segs, axis=1)
+    keep = key[:, 0] != key[:, 1]
+    _, first = np.unique(key, axis=0, return_index=True)
+    first = np.sort(first[keep[first]])
+    return segs[first], src[first]
+
+
+def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None,
+                      counts: dict | None = None):
+    """Split each segment at the vertices lying on its interior: exactly (decided with
+    the exact orientation predicate), or, for a vertex on no polygon ring (a line's end
+    or bend, a lone point), within `tol` of it (see snap_tolerance).  ring_source[s]
+    says whether source s is a ring; without it, only vertices with at most one
+    segment are snapped.  ``counts['snapped']``, if given, counts the near splits."""
+    if len(segs) == 0:
+        return segs, src
+    segs = np.asarray(segs)
+    lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
+    reach = max(tol, CANDIDATE_REACH * float(np.abs(pts).max() + 1.0))
+    vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
+    other = (vi != segs[si, 0]) & (vi != segs[si, 1])     # each segment finds its own ends
+    vi, si = vi[other], si[other]
+    cuts: dict[int, list[int]] = {}
+    if ring_source is None:
+        fixed = np.bincount(segs.ravel(), minlength=len(pts)) > 1
+    else:
+        fixed = np.zeros(len(pts), dtype=bool)
+        fixed[segs[ring_source[np.asarray(src)]].ravel()] = True
+    for v, k in zip(vi.tolist(), si.tolist()):
+        a, b = segs[k]
+        pa, pb, pv = pts[a], pts[b], pts[v]
+        if not (np.dot(pv - pa, pb - pa) > 0 and np.dot(pv - pb, pa - pb) > 0):
+            continue
+        if py_orient2d(pa[0], pa[1], pb[0], pb[1], pv[0], pv[1]) != 0:
+            d = pb - pa
+            cross = d[0] * (pv[1] - pa[1]) - d[1] * (pv[0] - pa[0])
+            if not abs(cross) <= tol * float(np.hypot(d[0], d[1])):
+                continue
+            # near, not on: a constraint line's vertex (or a lone point) is meant to
+            # be on the segment, as in a crack ending on the boundary at a computed
+            # point.  A ring's corner is not: a valid polygon may have a hole an ulp
+            # from its outer ring or a needle an ulp wide, and snapping would close
+            # the gap or fold the needle, so it stays (generate drops split points
+            # that near it, see boundary.discretize).
+            if fixed[v]:
+                continue
+            if counts is not None:
+                counts["snapped"] += 1
+        cuts.setdefault(k, []).append(v)
+    if not cuts:
+        return segs, src
+    if note is not None:
+        note.append(f"split {len(cuts)} segments at vertices lying on them")
+    return _cut(pts, segs, src, cuts)
+
+
+def refuse_crossings(pts, seg):
+    """Dict / .poly input: segments crossing at a point inside both are refused (the
+    policy of aftmesh.cdt), before any size-dependent splitting could hide them."""
+    if len(seg) < 2:
+        return
+    lines = shapely.linestrings(np.stack([pts[seg[:, 0]], pts[seg[:, 1]]], axis=1))
+    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
+    pairs = pairs[:, pairs[0] < pairs[1]]
+    if pairs.shape[1]:
+        i, j = (int(x) for x in pairs[:, 0])
+        raise CrossingSegmentsError(
+            f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
+            f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
+            f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})", (i, j))

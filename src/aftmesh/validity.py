@@ -1,0 +1,144 @@
+"""Validation of shapely input, with messages that name the ring or line at fault and
+where it goes wrong.
+
+Real GIS data is often invalid in more than one way at once (a self-touching exterior
+and two overlapping holes); the messages list each problem with its own place, so the
+user can find it without a GIS at hand.
+"""
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import shapely
+from shapely.geometry import Polygon
+
+from .errors import InvalidDomainError
+from .noding import snap_tolerance
+
+__all__ = ["check_lines_inside", "check_polygon"]
+
+_WHERE = re.compile(r"\[([-+0-9.eEinfa]+) ([-+0-9.eEinfa]+)\]")
+
+
+def _xy(x, y) -> str:
+    return f"({float(x)!r}, {float(y)!r})"
+
+
+def validity_reason(geom) -> str:
+    """shapely's validity reason, with its location written as (x, y)."""
+    reason = shapely.is_valid_reason(geom)
+    return _WHERE.sub(lambda m: " at " + _xy(m.group(1), m.group(2)), reason)
+
+
+def _check_finite(poly: Polygon, where: str) -> None:
+    for k, ring in enumerate([poly.exterior, *poly.interiors]):
+        c = np.asarray(ring.coords)
+        bad = ~np.isfinite(c).all(axis=1)
+        if bad.any():
+            name = "exterior ring" if k == 0 else f"hole {k - 1}"
+            i = int(np.flatnonzero(bad)[0])
+            raise InvalidDomainError(f"{where}, {name}: vertex {i} = {c[i].tolist()} is not finite")
+
+
+def _hole_problems(poly: Polygon) -> list[str]:
+    """Holes that are invalid alone, overlap another hole, or leave the exterior."""
+    problems = []
+    outer = Polygon(poly.exterior)
+    holes = [Polygon(h) for h in poly.interiors]
+    for k, hole in enumerate(holes):
+        if not hole.is_valid:
+            problems.append(f"hole {k}: {validity_reason(hole)}")
+        elif outer.is_valid and not outer.contains(hole):
+            p = hole.difference(outer).representative_point()
+            problems.append(f"hole {k} is not inside the exterior ring (at {_xy(*p.coords[0])})")
+    valid = np.array([h for h in holes if h.is_valid], dtype=object)
+    if len(valid) < 2:
+        return problems
+    tree = shapely.STRtree(valid)
+    index = [k for k, h in enumerate(holes) if h.is_valid]
+    for i, j in tree.query(valid, predicate="intersects").T.tolist():
+        if i >= j:
+            continue
+        common = valid[i].intersection(valid[j])
+        if common.area > 0:
+            problems.append(f"holes {index[i]} and {index[j]} overlap at "
+                            f"{_xy(*common.representative_point().coords[0])}")
+        elif common.geom_type != "Point":
+            p = shapely.get_coordinates(common)[0]
+            problems.append(f"holes {index[i]} and {index[j]} touch along a line or at "
+                            f"more than one point, at {_xy(*p)}")
+    return problems
+
+
+def check_polygon(poly: Polygon, where: str) -> None:
+    """Refuse an empty, non-finite, invalid or zero-area polygon, naming each ring at
+    fault (exterior, hole k, holes i and j) and where."""
+    if poly.is_empty:
+        raise InvalidDomainError(f"{where} is empty")
+    _check_finite(poly, where)
+    if not poly.is_valid:
+        problems = []
+        outer = Polygon(poly.exterior)
+        if not outer.is_valid:
+            problems.append(f"the exterior ring: {validity_reason(outer)}")
+        problems += _hole_problems(poly)
+        if not problems:
+            problems.append(f"its rings: {validity_reason(poly)}")
+        raise InvalidDomainError(f"{where} is not a valid polygon: " + "; ".join(problems))
+    if not poly.area > 0:
+        coords = np.asarray(poly.exterior.coords)
+        raise InvalidDomainError(f"{where} has zero area (vertices {coords[:4].tolist()}...)")
+
+
+def _outside_by_rounding(outside, union, tol: float) -> bool:
+    """Whether the parts of a constraint line outside the domain are there only by
+    rounding (a line ending on the boundary at a computed point, which the noding
+    then puts on the boundary): each part's ends and middle lie within `tol` of the
+    domain.  (A straight part whose ends and middle are that near a polygon is that
+    near it all along, unless the polygon has a feature right there, which the line
+    would then cross, splitting the part.)"""
+    parts = [p for p in shapely.get_parts(outside) if not p.is_empty]
+    probes = []
+    for p in parts:
+        c = shapely.get_coordinates(p)
+        probes.extend([c[0], c[-1], 0.5 * (c[0] + c[-1])])
+    if not probes:
+        return True
+    return bool((shapely.distance(union, shapely.points(np.array(probes))) <= tol).all())
+
+
+def _leaves_at(line, union) -> np.ndarray:
+    """The first point of `line` (along it) that is outside the domain's interior
+    and boundary: where it leaves, or its start if it starts outside."""
+    outside = line.difference(union)
+    best, best_t = None, np.inf
+    for part in shapely.get_parts(outside):
+        if part.is_empty:
+            continue
+        c = shapely.get_coordinates(part)
+        t = line.project(shapely.Point(c[0]))
+        if t < best_t:
+            best, best_t = c[0], t
+    return best if best is not None else shapely.get_coordinates(line)[0]
+
+
+def check_lines_inside(polygons, lines, line_names, points, tolerance: float = 0.0) -> None:
+    """Refuse constraint lines or fixed points outside the domain (a line may stick
+    out by rounding only, see :func:`_outside_by_rounding`, or by `tolerance`)."""
+    union = shapely.union_all(polygons)
+    tol = None
+    for line, name in zip(lines, line_names):
+        if union.covers(line):
+            continue
+        if tol is None:
+            tol = max(tolerance, snap_tolerance(np.concatenate(
+                [shapely.get_coordinates(g) for g in (*polygons, *lines)])))
+        if not _outside_by_rounding(line.difference(union), union, tol):
+            p = _leaves_at(line, union)
+            raise InvalidDomainError(
+                f"{name} is not inside the domain: it leaves the domain at {_xy(*p)}")
+    for k, p in enumerate(points):
+        if not union.covers(p):
+            raise InvalidDomainError(
+                f"fixed point {k} = {list(p.coords)[0]} is not inside the domain")
