@@ -230,6 +230,7 @@ def run_front(kernel, opts: Options, triangle_hint: int) -> None:
             if isinstance(bar, _ProgressBar):
                 bar.close()
         return
+    assert opts.strategy is not None     # the compiled loop returned above otherwise
     basic_aft(kernel, opts.strategy)
     if kernel.counters()["unmeshed"] != 0:
         raise InvalidOptionError(

@@ -66,8 +66,10 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         problems.append(f"triangles {T.dtype} {T.shape} / neighbors {N.shape}")
     if len(mesh.regions) != t:
         problems.append(f"regions has {len(mesh.regions)} entries for {t} triangles")
-    if len(mesh.segment_markers) != len(S):
-        problems.append(f"segment_markers has {len(mesh.segment_markers)} entries for {len(S)} segments")
+    markers = mesh.segment_markers
+    if markers is None or len(markers) != len(S):
+        n_markers = "no" if markers is None else len(markers)
+        problems.append(f"segment_markers has {n_markers} entries for {len(S)} segments")
     if problems:
         raise MeshCheckError("; ".join(problems))
     if t == 0:

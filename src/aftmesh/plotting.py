@@ -88,6 +88,7 @@ def plot_mesh(mesh, ax=None, color_by: str = "quality", show_segments: bool = Tr
         edge_style = dict(edgecolors=edge_color if edge_width > 0 else "none",
                           linewidth=edge_width)
         if color_by == "quality":
+            assert q is not None
             art = ax.tripcolor(P[:, 0], P[:, 1], T, facecolors=q["radius_ratio"],
                                cmap=cmap or "viridis", norm=Normalize(0.0, 1.0),
                                **edge_style, **kwargs)

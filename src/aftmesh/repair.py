@@ -50,7 +50,8 @@ def _polygonal(geom, name: str, report: dict):
 
 def _repair_collection(domain, report: dict):
     parts = shapely.get_parts(domain) if isinstance(domain, GeometryCollection) else [domain]
-    polygons, others = [], []
+    polygons: list = []
+    others: list = []
     for part in parts:
         (polygons if isinstance(part, (Polygon, MultiPolygon)) else others).append(part)
     named = [(p, f"polygon {k}" if len(polygons) > 1 else "the polygon")
