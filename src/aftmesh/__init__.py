@@ -9,8 +9,9 @@ from .generate import generate
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
                      InvalidOptionError, InvalidSizeError, KernelError)
 from .mesh import Mesh
+from .parallel import MeshingFailure, generate_many, imap_many  # noqa: F401  (parallel use)
 
 __version__ = "0.1.0"
 
-__all__ = ["cdt", "generate", "Mesh", "InvalidInputError", "InvalidDomainError",
-           "CrossingSegmentsError", "InvalidSizeError", "InvalidOptionError", "KernelError"]
+__all__ = ["cdt", "generate", "generate_many", "imap_many", "MeshingFailure", "Mesh",
+           "InvalidInputError", "InvalidDomainError", "CrossingSegmentsError", "InvalidSizeError", "InvalidOptionError", "KernelError"]
