@@ -74,12 +74,12 @@ def dask_client():
             os.environ["PYTHONPATH"] = old
 
 
-BACKENDS = [dict(scheduler="serial"), dict(scheduler="threads", workers=2), "dask"]
+BACKENDS = [{"scheduler": "serial"}, {"scheduler": "threads", "workers": 2}, "dask"]
 
 
 def backend(kind, request):
     if kind == "dask":
-        return dict(client=request.getfixturevalue("dask_client"))
+        return {"client": request.getfixturevalue("dask_client")}
     return kind
 
 
@@ -122,7 +122,7 @@ def test_dask_batches_of_domains_give_the_same_meshes(dask_client, serial_meshes
 
 
 def test_imap_many_yields_every_index_once_from_a_generator(serial_meshes, checked):
-    domains, sizes = batch()
+    domains, _sizes = batch()
     lazy = (d for i, d in enumerate(domains) if i != BAD_INDEX)
     got = dict(aftmesh.imap_many(lazy, 0.1, workers=2))
     assert sorted(got) == list(range(len(domains) - 1))
@@ -161,10 +161,10 @@ def test_sizes_not_matching_the_domains_are_refused_naming_both_lengths():
 
 
 @pytest.mark.parametrize("options, message", [
-    (dict(scheduler="mpi"), "scheduler='mpi' is not a valid option"),
-    (dict(errors="ignore"), "errors='ignore' is not a valid option"),
-    (dict(workers=0), "workers must be a positive integer"),
-    (dict(scheduler="dask"), "no active dask.distributed Client"),
+    ({"scheduler": "mpi"}, "scheduler='mpi' is not a valid option"),
+    ({"errors": "ignore"}, "errors='ignore' is not a valid option"),
+    ({"workers": 0}, "workers must be a positive integer"),
+    ({"scheduler": "dask"}, "no active dask.distributed Client"),
 ])
 def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(aftmesh.InvalidOptionError, match=message):

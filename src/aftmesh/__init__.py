@@ -9,7 +9,7 @@ from .generate import generate
 from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
                      InvalidOptionError, InvalidSizeError, KernelError)
 from .mesh import Mesh
-from .parallel import MeshingFailure, generate_many, imap_many  # noqa: F401  (parallel use)
+from .parallel import MeshingFailure, generate_many, imap_many
 
 __version__ = "0.1.0"
 

@@ -15,8 +15,9 @@ from __future__ import annotations
 import concurrent.futures as cf
 import copy
 import os
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import Any, Callable, Iterable, Iterator
+from typing import Any
 
 import numpy as np
 
@@ -262,9 +263,7 @@ def _results(items, total, scheduler, workers, client, errors, progress, chunksi
         stream = _threads(items, options, workers or os.cpu_count() or 1, chunksize)
     else:
         stream = _dask(items, options, client, chunksize or 1)
-    done = 0
-    for index, result in stream:
-        done += 1
+    for done, (index, result) in enumerate(stream, start=1):
         if isinstance(result, MeshingFailure) and errors == "raise":
             stream.close()
             raise _with_index(result) from result.error
