@@ -3,8 +3,6 @@ backend (threads, serial, a real Dask cluster of 2 worker processes), with a fai
 domain in the batch raised with its index or collected in its slot."""
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 from shapely.geometry import Point, box
@@ -50,28 +48,6 @@ def checked_module():
         check_mesh(mesh, **kw)
         return mesh
     return run
-
-
-@pytest.fixture(scope="module")
-def dask_client():
-    distributed = pytest.importorskip(
-        "distributed", reason="dask.distributed is not installed (pip install aftmesh[dask])")
-    # worker processes import aftmesh: hand them the path it was imported from
-    src = os.path.dirname(os.path.dirname(aftmesh.__file__))
-    old = os.environ.get("PYTHONPATH")
-    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (src, old) if p)
-    cluster = distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
-                                       dashboard_address=None, silence_logs=40)
-    client = distributed.Client(cluster, set_as_default=False)
-    try:
-        yield client
-    finally:
-        client.close()
-        cluster.close()
-        if old is None:
-            os.environ.pop("PYTHONPATH", None)
-        else:
-            os.environ["PYTHONPATH"] = old
 
 
 BACKENDS = [{"scheduler": "serial"}, {"scheduler": "threads", "workers": 2}, "dask"]

@@ -23,6 +23,8 @@ _ORDERS = {"shortest": 0, "longest": 1, "oldest": 2}
 MAX_SMOOTH = 1000           # smoothing rounds; it stops earlier once nothing moves
 # Kernel indices are int32: refuse a request for more triangles than that can number
 MAX_TRIANGLES = 2 ** 30
+_FORWARD = ("max_triangles", "min_area", "order", "greedy", "swaps", "split_boundary",
+            "gradation", "close_factor", "smooth", "strategy", "progress")
 
 
 class _ProgressBar:
@@ -125,7 +127,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
              min_area: float | None = None, order: str = "shortest", greedy: bool = False,
              swaps: bool = True, split_boundary: bool = True,
              gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
-             smooth: int = 3, strategy: Strategy | None = None, progress=None) -> Mesh:
+             smooth: int = 3, strategy: Strategy | None = None, progress=None,
+             partitions: int | None = None, client=None) -> Mesh:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -177,6 +180,12 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         A progress bar (fraction of the area meshed) on standard error: by default
         shown only when standard error is a terminal and the mesh is large; True or
         False to force it; a callable ``f(fraction)`` to receive the fraction instead.
+    partitions : int, optional
+        Cut the domain into this many parts of about equal triangle counts and mesh
+        them at once (threads, or Dask tasks with ``client``), then stitch them into
+        one conforming constrained Delaunay mesh (see :mod:`aftmesh.partition`).
+    client : distributed.Client, optional
+        Mesh the parts as tasks of this Dask client.
 
     Returns
     -------
@@ -193,6 +202,10 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     >>> abs(mesh.area() - domain.area) < 1e-9
     True
     """
+    if partitions is not None or client is not None:     # one domain in parts: partition.py
+        from .partition import generate_partitioned
+        return generate_partitioned(domain, size, partitions=partitions or 1, client=client,
+                                    options={k: v for k, v in locals().items() if k in _FORWARD})
     t_start = time.perf_counter()
     _check_options(order, max_triangles, min_area, close_factor, smooth, strategy,
                    dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary))
