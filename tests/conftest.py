@@ -9,10 +9,9 @@ import signal
 
 import numpy as np
 import pytest
-
-import aftmesh
 from hypothesis import HealthCheck, settings
 
+import aftmesh
 from aftmesh.checks import check_mesh
 
 settings.register_profile(

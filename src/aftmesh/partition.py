@@ -256,8 +256,8 @@ def part_inputs(C: Mesh, leaves, locate) -> list[dict]:
             hit = np.unique(tree.query(shapely.points(others), predicate="intersects")[0])
             others = others[hit]
         regions = np.c_[probes[mine], label[mine]]
-        out.append(dict(vertices=pts, segments=local, holes=others.reshape(-1, 2),
-                        regions=regions))
+        out.append({"vertices": pts, "segments": local, "holes": others.reshape(-1, 2),
+                        "regions": regions})
     return out
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from . import _kernel
 from .errors import KernelError
 
-__all__ = ["stitch_parts", "lawson_flips"]
+__all__ = ["lawson_flips", "stitch_parts"]
 
 
 def _void(xy: np.ndarray) -> np.ndarray:
