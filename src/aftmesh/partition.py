@@ -72,18 +72,24 @@ def split_by_size(p0: np.ndarray, p1: np.ndarray, field) -> np.ndarray:
 
 
 class _Locator:
-    """Which region (if any) holds each point, by the boundary's triangulation."""
+    """Which region (if any) holds each point: one prepared polygon per region, the
+    union of the boundary triangulation's triangles of that region (a point tree over
+    those triangles would be slow: a greedy triangulation is made of long slivers)."""
 
     def __init__(self, b: Boundary):
-        self.tree = shapely.STRtree(shapely.polygons(b.points[b.triangles]))
-        self.regions = b.regions
+        tri = shapely.polygons(b.points[b.triangles])
+        self.labels = np.unique(b.regions)
+        self.polygons = [shapely.coverage_union_all(tri[b.regions == r]) for r in self.labels]
+        for poly in self.polygons:
+            shapely.prepare(poly)
 
     def __call__(self, xy: np.ndarray):
-        pi, ti = self.tree.query(shapely.points(xy), predicate="intersects")
         inside = np.zeros(len(xy), dtype=bool)
         label = np.zeros(len(xy), dtype=np.int64)
-        inside[pi] = True
-        label[pi] = self.regions[ti]
+        for r, poly in zip(self.labels, self.polygons):
+            hit = shapely.intersects_xy(poly, xy[:, 0], xy[:, 1]) & ~inside
+            inside |= hit
+            label[hit] = r
         return inside, label
 
 
