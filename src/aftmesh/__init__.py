@@ -10,8 +10,9 @@ from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidInputErro
                      InvalidOptionError, InvalidSizeError, KernelError)
 from .mesh import Mesh
 from .parallel import MeshingFailure, generate_many, imap_many
+from .pvtu import read_partitioned
 
 __version__ = "0.1.0"
 
-__all__ = ["cdt", "generate", "generate_many", "imap_many", "MeshingFailure", "Mesh",
+__all__ = ["cdt", "generate", "generate_many", "imap_many", "MeshingFailure", "read_partitioned", "Mesh",
            "InvalidInputError", "InvalidDomainError", "CrossingSegmentsError", "InvalidSizeError", "InvalidOptionError", "KernelError"]

@@ -128,7 +128,7 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
              swaps: bool = True, split_boundary: bool = True,
              gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
              smooth: int = 3, strategy: Strategy | None = None, progress=None,
-             partitions: int | None = None, client=None) -> Mesh:
+             partitions: int | None = None, client=None, out=None) -> Mesh:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -186,6 +186,11 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         one conforming constrained Delaunay mesh (see :mod:`aftmesh.partition`).
     client : distributed.Client, optional
         Mesh the parts as tasks of this Dask client.
+    out : str or Path, optional
+        With ``partitions``: write each part as a ``.vtu`` (with global vertex ids) plus
+        a ``mesh.pvtu`` into this directory, from the worker that meshed it, and
+        return the ``.pvtu`` path instead of a Mesh (read it with
+        :func:`aftmesh.read_partitioned`).
 
     Returns
     -------
@@ -202,10 +207,11 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     >>> abs(mesh.area() - domain.area) < 1e-9
     True
     """
-    if partitions is not None or client is not None:     # one domain in parts: partition.py
+    if partitions is not None or client is not None or out is not None:   # partition.py
         from .partition import generate_partitioned
         return generate_partitioned(domain, size, partitions=partitions or 1, client=client,
-                                    options={k: v for k, v in locals().items() if k in _FORWARD})
+                                    out=out, options={k: v for k, v in locals().items()
+                                                      if k in _FORWARD})
     t_start = time.perf_counter()
     _check_options(order, max_triangles, min_area, close_factor, smooth, strategy,
                    dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary))

@@ -234,16 +234,17 @@ def _face_owners(C: Mesh, face, n_faces, leaves, locate):
     return probes, owner, inside, label
 
 
-def part_inputs(C: Mesh, leaves, locate) -> list[dict]:
+def part_inputs(C: Mesh, leaves, locate) -> tuple[list[dict], list[np.ndarray]]:
     """One Triangle-style dict per non-empty part: its vertices and segments, a
-    region point per face it meshes, a hole point per other face it encloses."""
+    region point per face it meshes, a hole point per other face it encloses; and
+    the coarse ids of each part's vertices."""
     face, n_faces, is_seg = _faces(C)
     probes, owner, inside, label = _face_owners(C, face, n_faces, leaves, locate)
     T = C.triangles
     a, b = T[:, [1, 2, 0]], T[:, [2, 0, 1]]
     on_seg = np.zeros(len(C.points), dtype=bool)
     on_seg[C.segments.ravel()] = True
-    out = []
+    out, ids = [], []
     for p in range(len(leaves)):
         mine = (owner == p) & inside
         tri_mine = mine[face]
@@ -263,8 +264,9 @@ def part_inputs(C: Mesh, leaves, locate) -> list[dict]:
             others = others[hit]
         regions = np.c_[probes[mine], label[mine]]
         out.append({"vertices": pts, "segments": local, "holes": others.reshape(-1, 2),
-                        "regions": regions})
-    return out
+                    "regions": regions})
+        ids.append(used)
+    return out, ids
 
 
 def _coarse_cdt(points, segments) -> Mesh:
@@ -312,13 +314,15 @@ def _cut_pslg(b: Boundary, k: int):
 
 
 def generate_partitioned(domain, size=None, *, partitions: int, client=None,
-                         workers: int | None = None, options: dict | None = None) -> Mesh:
-    """``aftmesh.generate(domain, size, partitions=k, client=...)``: see the module
-    documentation.  ``options`` are generate's other keyword options."""
+                         workers: int | None = None, out=None, options: dict | None = None):
+    """``aftmesh.generate(domain, size, partitions=k, client=..., out=...)``: see the
+    module documentation.  ``options`` are generate's other keyword options.  With
+    ``out`` (a directory) the parts are written there by the workers that mesh them
+    (see :mod:`aftmesh.partition_io`) and the path of the ``.pvtu`` is returned."""
     from .generate import generate
     options = {k: v for k, v in (options or {}).items() if v is not None}
     k = _check(partitions, options)
-    if k == 1 and client is None:
+    if k == 1 and client is None and out is None:
         return generate(domain, size, **options)
     t0 = time.perf_counter()
     b = discretized_boundary(domain, size, options)
@@ -329,14 +333,21 @@ def generate_partitioned(domain, size=None, *, partitions: int, client=None,
             "a cut runs through a vertex of the boundary"
     except CrossingSegmentsError:
         reason = "a cut crosses the boundary's pieces"
-    if reason is not None:
+    if reason is not None and out is None:
         mesh = generate(domain, size, **options)
         mesh.info["partition_fallback"] = reason
         return mesh
-    parts = part_inputs(C, leaves, locate)
+    if reason is not None:
+        raise InvalidOptionError(f"out= cannot write this domain in parts: {reason}")
+    parts, ids = part_inputs(C, leaves, locate)
     t1 = time.perf_counter()
     part_options = {key: v for key, v in options.items()
                     if key not in ("split_boundary", "progress", "greedy")}
+    if out is not None:
+        from .partition_io import part_meta, write_parts
+        metas = part_meta(C, ids, b.points[b.segments], b.markers)
+        return write_parts(out, parts, metas, b.field, part_options, _mesh_part, client,
+                           workers)
     meshes = _run_parts(parts, b.field, part_options, client, workers)
     t2 = time.perf_counter()
     xy = b.points[b.segments]
