@@ -62,16 +62,19 @@ def stitch_parts(meshes, input_xy: np.ndarray, input_markers: np.ndarray):
     :func:`lawson_flips`."""
     points, maps, shared_keys = global_numbering(meshes)
     n = len(points)
-    tris, nbrs, regions = [], [], []
+    total = sum(m.n_triangles for m in meshes)
+    T = np.empty((total, 3), dtype=np.int32)
+    N = np.empty((total, 3), dtype=np.int32)
+    R = np.empty(total, dtype=np.int32)
     offset = 0
     for m, new in zip(meshes, maps):
-        tris.append(new[m.triangles])
-        nbrs.append(np.where(m.neighbors >= 0, m.neighbors + offset, -1))
-        regions.append(m.regions)
-        offset += len(m.triangles)
-    T = np.concatenate(tris).astype(np.int32)
-    N = np.concatenate(nbrs).astype(np.int32)
-    R = np.concatenate(regions).astype(np.int32)
+        end = offset + m.n_triangles
+        T[offset:end] = new.astype(np.int32)[m.triangles]
+        N[offset:end] = m.neighbors
+        part = N[offset:end]
+        part[part >= 0] += offset
+        R[offset:end] = m.regions
+        offset = end
     # join the parts: a boundary half-edge (a, b) of one part meets (b, a) of another
     t, k = np.nonzero(N < 0)
     a = T[t, (k + 1) % 3].astype(np.int64)
