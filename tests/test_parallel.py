@@ -97,6 +97,16 @@ def test_dask_batches_of_domains_give_the_same_meshes(dask_client, serial_meshes
         assert_same(checked(mesh), ref)
 
 
+@pytest.mark.parametrize("kind", BACKENDS, ids=["serial", "threads", "dask"])
+def test_more_domains_than_tasks_in_flight_all_come_back_in_order(kind, request, checked):
+    # 2 workers keep at most 8 tasks in flight: 30 domains refill the window many times
+    domains = [box(i, 0, i + 1, 1 + 0.1 * i) for i in range(30)]
+    out = aftmesh.generate_many(domains, 0.5, chunksize=2 if kind == "dask" else None,
+                                **backend(kind, request))
+    for i, mesh in enumerate(out):
+        assert checked(mesh).area() == pytest.approx(domains[i].area, rel=1e-12)
+
+
 def test_imap_many_yields_every_index_once_from_a_generator(serial_meshes, checked):
     domains, _sizes = batch()
     lazy = (d for i, d in enumerate(domains) if i != BAD_INDEX)

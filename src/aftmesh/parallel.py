@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import copy
+import itertools
 import os
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
@@ -197,7 +198,7 @@ def _dask(items, options, client, chunksize) -> Iterator[tuple[int, Any]]:
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     batches = _batches(items, chunksize)
     pending = {client.submit(_mesh_batch, b, options, pure=False)
-               for b, _ in zip(batches, range(n_workers * IN_FLIGHT_PER_WORKER))}
+               for b in itertools.islice(batches, n_workers * IN_FLIGHT_PER_WORKER)}
     queue = as_completed(list(pending), loop=client.loop)
     try:
         for fut in queue:
