@@ -141,7 +141,7 @@ def main(quick: bool, out_dir: Path) -> int:
 
     def cluster():
         lc = distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
-                                      dashboard_address=None, silence_logs=40)
+                                      dashboard_address=":0", silence_logs=40)
         client = distributed.Client(lc, set_as_default=False)
 
         class Both:
