@@ -133,3 +133,14 @@ def test_parts_written_by_their_workers_read_back_as_the_stitched_mesh(
     assert triangle_coordinates(back) == triangle_coordinates(stitched)
     assert marked_edges(back) == marked_edges(stitched)
     assert region_areas(back) == pytest.approx(region_areas(stitched), rel=1e-12)
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"partitions": 0}, "partitions must be a positive integer, got 0"),
+    ({"partitions": 2.5}, "partitions must be a positive integer"),
+    ({"partitions": 2, "greedy": True}, "greedy=True adds no point"),
+    ({"partitions": 2, "max_triangles": 100}, "max_triangles cannot be combined"),
+])
+def test_bad_partition_options_are_refused_by_name(options, message):
+    with pytest.raises(aftmesh.InvalidOptionError, match=message):
+        aftmesh.generate(box(0, 0, 1, 1), 0.1, **options)
