@@ -209,9 +209,9 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     """
     if partitions is not None or client is not None or out is not None:   # partition.py
         from .partition import generate_partitioned
-        return generate_partitioned(domain, size, partitions=partitions or 1, client=client,
-                                    out=out, options={k: v for k, v in locals().items()
-                                                      if k in _FORWARD})
+        return generate_partitioned(domain, size, partitions=1 if partitions is None else
+                                    partitions, client=client, out=out,
+                                    options={k: v for k, v in locals().items() if k in _FORWARD})
     t_start = time.perf_counter()
     _check_options(order, max_triangles, min_area, close_factor, smooth, strategy,
                    dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary))
