@@ -281,6 +281,8 @@ def _mesh_part(part: dict, field, options: dict) -> Mesh:
 
 def _run_parts(parts, field, options, client, workers):
     if client is not None:
+        # the size field goes to each worker once, not with every part
+        field = client.scatter(field, broadcast=True)
         futures = client.map(_mesh_part, parts, field=field, options=options, pure=False)
         return client.gather(futures)
     workers = workers or min(len(parts), os.cpu_count() or 1)

@@ -84,6 +84,7 @@ def write_parts(out, parts, metas, field, options, mesh_part, client, workers) -
     paths = [str(out / name) for name in names]
     n = metas[0]["n"] if metas else 0
     if client is not None:
+        field = client.scatter(field, broadcast=True)      # once per worker
         meshes = client.map(mesh_part, parts, field=field, options=options, pure=False)
         counts = client.gather(client.map(_count_new, meshes, parts, pure=False))
         offsets = (n + np.r_[0, np.cumsum(counts)[:-1]]).tolist()
