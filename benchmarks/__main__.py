@@ -85,6 +85,12 @@ def parse_args(argv):
     p.add_argument("--cdt", action="store_true", help="run the Delaunay/CDT comparison")
     p.add_argument("--all", action="store_true", help="meshing cases, --cdt and --scaling")
     p.add_argument(
+        "--parallel",
+        action="store_true",
+        help="generate_many and partitions=2 against serial runs, on threads and "
+        "a 2-worker Dask LocalCluster (needs distributed)",
+    )
+    p.add_argument(
         "--gmsh-limit",
         type=float,
         default=None,
@@ -124,6 +130,9 @@ def _main(argv) -> int:
         for k, (_label, desc) in MESHERS.items():
             print(f"mesher:  {k:14s} {desc}")
         return 0
+    if args.parallel:
+        from . import parallel
+        return parallel.main(args.quick, args.out)
     from . import plots, report, runner
 
     out: Path = args.out

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
+import aftmesh
 from aftmesh.checks import check_mesh
 
 settings.register_profile(
@@ -86,3 +87,26 @@ def default_sigint():
         yield
     finally:
         signal.signal(signal.SIGINT, old)
+
+
+@pytest.fixture(scope="module")
+def dask_client():
+    """A real Dask cluster of 2 worker processes (one thread each), per test module."""
+    distributed = pytest.importorskip(
+        "distributed", reason="dask.distributed is not installed (pip install aftmesh[dask])")
+    # worker processes import aftmesh: hand them the path it was imported from
+    src = os.path.dirname(os.path.dirname(aftmesh.__file__))
+    old = os.environ.get("PYTHONPATH")
+    os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (src, old) if p)
+    cluster = distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
+                                       dashboard_address=":0", silence_logs=40)
+    client = distributed.Client(cluster, set_as_default=False)
+    try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+        if old is None:
+            os.environ.pop("PYTHONPATH", None)
+        else:
+            os.environ["PYTHONPATH"] = old

@@ -17,12 +17,18 @@ from .errors import (
 )
 from .generate import generate
 from .mesh import Mesh
+from .parallel import MeshingFailure, generate_many, imap_many
+from .pvtu import read_partitioned
 
 __all__ = [
     "__version__",
     "cdt",
     "generate",
     "Mesh",
+    "generate_many",
+    "imap_many",
+    "MeshingFailure",
+    "read_partitioned",
     "InvalidInputError",
     "InvalidDomainError",
     "CrossingSegmentsError",

@@ -16,13 +16,20 @@ from .sizing import DEFAULT_GRADATION
 
 __all__ = ["generate"]
 
+# generate's options that a partitioned run passes on (partition.py decides which
+# reach the parts and which only the run that discretizes the whole boundary)
+_FORWARD = ("max_triangles", "min_area", "order", "greedy", "swaps", "split_boundary",
+            "gradation", "close_factor", "smooth", "strategy", "progress", "repair",
+            "tolerance", "boundary_tags")
+
 
 def generate(domain, size=None, *, max_triangles: int | None = None,
              min_area: float | None = None, order: str = "shortest", greedy: bool = False,
              swaps: bool = True, split_boundary: bool = True,
              gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
              smooth: int = 3, strategy: Strategy | None = None, progress=None,
-             repair: bool = False, tolerance: float = 0.0, boundary_tags=None) -> Mesh:
+             repair: bool = False, tolerance: float = 0.0, boundary_tags=None,
+             partitions: int | None = None, client=None, out=None) -> Mesh:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -104,6 +111,17 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         the mesh gets ``segment_tags`` and ``tag_names``, and
         ``mesh.boundary_facets(name)`` returns the segments of a name.  An edge
         selected by two names raises InvalidOptionError.
+    partitions : int, optional
+        Cut the domain into this many parts of about equal triangle counts and mesh
+        them at once (threads, or Dask tasks with ``client``), then stitch them into
+        one conforming constrained Delaunay mesh (see :mod:`aftmesh.partition`).
+    client : distributed.Client, optional
+        Mesh the parts as tasks of this Dask client.
+    out : str or Path, optional
+        With ``partitions``: write each part as a ``.vtu`` (with global vertex ids) plus
+        a ``mesh.pvtu`` into this directory, from the worker that meshed it, and
+        return the ``.pvtu`` path instead of a Mesh (read it with
+        :func:`aftmesh.read_partitioned`).
 
     Returns
     -------
@@ -130,6 +148,12 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     >>> abs(mesh.area() - domain.area) < 1e-9
     True
     """
+    if partitions is not None or client is not None or out is not None:
+        from .partition import generate_partitioned
+        options = {k: v for k, v in locals().items() if k in _FORWARD}
+        return generate_partitioned(domain, size, partitions=1 if partitions is None else partitions,
+                                    client=client,
+                                    out=out, options=options)
     t_start = time.perf_counter()
     opts = check_options(order=order, max_triangles=max_triangles, min_area=min_area,
                          greedy=greedy, swaps=swaps, split_boundary=split_boundary,
