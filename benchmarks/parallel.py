@@ -11,6 +11,7 @@ Wall time and the CPU time of this process (Dask workers' CPU is not in it) are
 printed as a Markdown table and written to ``benchmarks/out/parallel.md``.  Timings
 on a shared machine: read the load average printed with them.
 """
+
 from __future__ import annotations
 
 import os
@@ -26,9 +27,9 @@ from shapely.geometry import Point, Polygon, box
 
 import aftmesh
 
-SQUARE_SIZES = {"1e6": 0.0015, "1e7": 0.00048}   # edge lengths giving ~1e6 / ~1e7 triangles
+SQUARE_SIZES = {"1e6": 0.0015, "1e7": 0.00048}  # edge lengths giving ~1e6 / ~1e7 triangles
 QUICK_SIZES = {"1e5": 0.0047, "1e6": 0.0015}
-SMALL_SIZE = 0.08                                # ~300 triangles per small polygon
+SMALL_SIZE = 0.08  # ~300 triangles per small polygon
 
 
 def small_polygons(n: int, seed: int = 0) -> list:
@@ -57,11 +58,21 @@ def _row(case, backend, meshes, wall, cpu, base_wall=None, base_rr=None):
     if isinstance(meshes, aftmesh.Mesh):
         meshes = [meshes]
     tri = sum(m.n_triangles for m in meshes)
-    rr = float(np.mean([m.quality()["radius_ratio_mean"] for m in meshes])) if len(meshes) == 1 \
+    rr = (
+        float(np.mean([m.quality()["radius_ratio_mean"] for m in meshes]))
+        if len(meshes) == 1
         else None
-    return {"case": case, "backend": backend, "triangles": tri, "wall": wall, "cpu": cpu,
-            "speedup": None if base_wall is None else base_wall / wall,
-            "rr": rr, "drr": None if rr is None or base_rr is None else rr - base_rr}
+    )
+    return {
+        "case": case,
+        "backend": backend,
+        "triangles": tri,
+        "wall": wall,
+        "cpu": cpu,
+        "speedup": None if base_wall is None else base_wall / wall,
+        "rr": rr,
+        "drr": None if rr is None or base_rr is None else rr - base_rr,
+    }
 
 
 def bench_many(n, client) -> list:
@@ -71,8 +82,7 @@ def bench_many(n, client) -> list:
     rows.append(_row(f"{n} polygons", "serial", serial, w0, c0))
     out, w, c = _timed(lambda: aftmesh.generate_many(doms, SMALL_SIZE, workers=2))
     rows.append(_row(f"{n} polygons", "2 threads", out, w, c, w0))
-    out, w, c = _timed(lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=client,
-                                                     chunksize=25))
+    out, w, c = _timed(lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=client, chunksize=25))
     rows.append(_row(f"{n} polygons", "Dask 2 procs", out, w, c, w0))
     return rows
 
@@ -98,19 +108,23 @@ def _peak_mib() -> float:
 
 def _serial_peak_mib(h: float) -> float:
     """Peak resident memory of a fresh process meshing the whole square serially."""
-    code = ("import resource, aftmesh; from shapely.geometry import box; "
-            f"aftmesh.generate(box(0, 0, 1, 1), {h!r}); "
-            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
+    code = (
+        "import resource, aftmesh; from shapely.geometry import box; "
+        f"aftmesh.generate(box(0, 0, 1, 1), {h!r}); "
+        "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     return int(out.stdout.split()[-1]) / 1024
 
 
 def bench_out(label, h, cluster_factory) -> dict:
     """Parts written by 2 fresh Dask worker processes: their peaks and the driver's."""
     with cluster_factory() as client, tempfile.TemporaryDirectory() as tmp:
-        index, wall, _ = _timed(lambda: aftmesh.generate(
-            box(0, 0, 1, 1), h, partitions=2, client=client, out=Path(tmp) / "parts"))
+        index, wall, _ = _timed(
+            lambda: aftmesh.generate(
+                box(0, 0, 1, 1), h, partitions=2, client=client, out=Path(tmp) / "parts"
+            )
+        )
         driver_peak = _peak_mib()
         worker_peak = max(client.run(_peak_mib).values())
         files = sum(f.stat().st_size for f in (Path(tmp) / "parts").iterdir()) / 2**20
@@ -119,20 +133,33 @@ def bench_out(label, h, cluster_factory) -> dict:
         # what one process holding the mesh needs: points, triangles, neighbors, regions
         whole = (16 * n_p + (12 + 12 + 4) * n_t) / 2**20
         del back
-    return {"case": f"square ~{label}, out=", "triangles": n_t, "wall": wall,
-            "serial_peak": _serial_peak_mib(h),
-            "driver_peak": driver_peak, "worker_peak": worker_peak,
-            "whole_mesh": whole, "files": files}
+    return {
+        "case": f"square ~{label}, out=",
+        "triangles": n_t,
+        "wall": wall,
+        "serial_peak": _serial_peak_mib(h),
+        "driver_peak": driver_peak,
+        "worker_peak": worker_peak,
+        "whole_mesh": whole,
+        "files": files,
+    }
 
 
 def _table(rows) -> str:
-    lines = [("| case | backend | triangles | wall | CPU (this process) | speed-up (wall) | "
-              "RR mean | RR - serial |"), "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        (
+            "| case | backend | triangles | wall | CPU (this process) | speed-up (wall) | "
+            "RR mean | RR - serial |"
+        ),
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        f = (lambda v, fmt: "-" if v is None else fmt.format(v))
-        lines.append(f"| {r['case']} | {r['backend']} | {r['triangles']} | {r['wall']:.2f} s | "
-                     f"{r['cpu']:.2f} s | {f(r['speedup'], '{:.2f}x')} | {f(r['rr'], '{:.4f}')} | "
-                     f"{f(r['drr'], '{:+.4f}')} |")
+        f = lambda v, fmt: "-" if v is None else fmt.format(v)
+        lines.append(
+            f"| {r['case']} | {r['backend']} | {r['triangles']} | {r['wall']:.2f} s | "
+            f"{r['cpu']:.2f} s | {f(r['speedup'], '{:.2f}x')} | {f(r['rr'], '{:.4f}')} | "
+            f"{f(r['drr'], '{:+.4f}')} |"
+        )
     return "\n".join(lines)
 
 
@@ -140,8 +167,13 @@ def main(quick: bool, out_dir: Path) -> int:
     import distributed
 
     def cluster():
-        lc = distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
-                                      dashboard_address=":0", silence_logs=40)
+        lc = distributed.LocalCluster(
+            n_workers=2,
+            processes=True,
+            threads_per_worker=1,
+            dashboard_address=":0",
+            silence_logs=40,
+        )
         client = distributed.Client(lc, set_as_default=False)
 
         class Both:
@@ -151,27 +183,36 @@ def main(quick: bool, out_dir: Path) -> int:
             def __exit__(self, *exc):
                 client.close()
                 lc.close()
+
         return Both()
 
     sizes = QUICK_SIZES if quick else SQUARE_SIZES
     load = [os.getloadavg()[0]]
     largest = list(sizes.items())[-1]
-    mem = bench_out(*largest, cluster)       # first: the driver's peak is still its own
+    mem = bench_out(*largest, cluster)  # first: the driver's peak is still its own
     rows = []
     with cluster() as client:
         rows += bench_many(200 if quick else 1000, client)
         for label, h in sizes.items():
             rows += bench_square(label, h, client)
     load.append(os.getloadavg()[0])
-    text = [(f"Parallel meshing, {time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} cores, "
-             f"load average {load[0]:.1f} at the start, {load[1]:.1f} at the end (a shared "
-             "machine: wall times and speed-ups are only as good as the free cores)."), "",
-            _table(rows), "",
-            (f"{mem['case']}: {mem['triangles']} triangles written by 2 Dask workers in "
+    text = [
+        (
+            f"Parallel meshing, {time.strftime('%Y-%m-%d %H:%M')}, {os.cpu_count()} cores, "
+            f"load average {load[0]:.1f} at the start, {load[1]:.1f} at the end (a shared "
+            "machine: wall times and speed-ups are only as good as the free cores)."
+        ),
+        "",
+        _table(rows),
+        "",
+        (
+            f"{mem['case']}: {mem['triangles']} triangles written by 2 Dask workers in "
             f"{mem['wall']:.1f} s ({mem['files']:.0f} MiB of .vtu); peak resident memory: "
             f"largest worker {mem['worker_peak']:.0f} MiB, driver {mem['driver_peak']:.0f} MiB; "
             f"one process meshing it whole peaks at {mem['serial_peak']:.0f} MiB "
-             f"(the final arrays alone: {mem['whole_mesh']:.0f} MiB).")]
+            f"(the final arrays alone: {mem['whole_mesh']:.0f} MiB)."
+        ),
+    ]
     report = "\n".join(text)
     print(report)
     out_dir.mkdir(parents=True, exist_ok=True)

@@ -8,6 +8,7 @@ Wall-clock thresholds depend on the machine and its load, so the default run doe
 assert them: tests marked ``timing`` are skipped, and the ``time_limit`` fixture only
 records the time, unless ``AFTMESH_TIMING_TESTS=1`` is set or ``-m timing`` is given.
 """
+
 import os
 import signal
 
@@ -19,11 +20,19 @@ import aftmesh
 from aftmesh.checks import check_mesh
 
 settings.register_profile(
-    "ci", max_examples=60, derandomize=True, deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    "ci",
+    max_examples=60,
+    derandomize=True,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 settings.register_profile(
-    "long", max_examples=2000, derandomize=False, deadline=None,
-    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+    "long",
+    max_examples=2000,
+    derandomize=False,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 settings.load_profile(os.environ.get("AFTMESH_TEST_PROFILE", "ci"))
 
 TIMING_ENV = "AFTMESH_TIMING_TESTS"
@@ -60,6 +69,7 @@ def time_limit(request, record_property):
         record_property(what, round(seconds, 3))
         if enforce:
             assert seconds < limit, f"{what}: {seconds:.2f} s, limit {limit} s"
+
     return check
 
 
@@ -71,9 +81,11 @@ def rng():
 @pytest.fixture
 def checked():
     """``checked(mesh, **kw)`` runs the invariant checker and returns the mesh."""
+
     def run(mesh, **kw):
         check_mesh(mesh, **kw)
         return mesh
+
     return run
 
 
@@ -93,13 +105,15 @@ def default_sigint():
 def dask_client():
     """A real Dask cluster of 2 worker processes (one thread each), per test module."""
     distributed = pytest.importorskip(
-        "distributed", reason="dask.distributed is not installed (pip install aftmesh[dask])")
+        "distributed", reason="dask.distributed is not installed (pip install aftmesh[dask])"
+    )
     # worker processes import aftmesh: hand them the path it was imported from
     src = os.path.dirname(os.path.dirname(aftmesh.__file__))
     old = os.environ.get("PYTHONPATH")
     os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (src, old) if p)
-    cluster = distributed.LocalCluster(n_workers=2, processes=True, threads_per_worker=1,
-                                       dashboard_address=":0", silence_logs=40)
+    cluster = distributed.LocalCluster(
+        n_workers=2, processes=True, threads_per_worker=1, dashboard_address=":0", silence_logs=40
+    )
     client = distributed.Client(cluster, set_as_default=False)
     try:
         yield client

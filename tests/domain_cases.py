@@ -6,6 +6,7 @@ Every builder returns a :class:`Case`: the domain in one of the input forms that
 asking aftmesh: the exact area, the input edges as coordinate pairs, the input
 vertices, and a modest target size.
 """
+
 from __future__ import annotations
 
 import math
@@ -25,15 +26,15 @@ from shapely.geometry import MultiPolygon, Point, Polygon, box
 @dataclass(frozen=True)
 class Case:
     name: str
-    domain: object            # what is passed to aftmesh.generate
-    area: float               # exact area of the domain
-    edges: np.ndarray         # (k, 2, 2) input edges as coordinate pairs
-    vertices: np.ndarray      # (n, 2) distinct input vertices (incl. isolated ones)
-    size: float               # a modest target edge length
+    domain: object  # what is passed to aftmesh.generate
+    area: float  # exact area of the domain
+    edges: np.ndarray  # (k, 2, 2) input edges as coordinate pairs
+    vertices: np.ndarray  # (n, 2) distinct input vertices (incl. isolated ones)
+    size: float  # a modest target edge length
     holes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))  # a point per hole
-    isolated: int = 0         # input vertices strictly inside the domain (fixed points)
+    isolated: int = 0  # input vertices strictly inside the domain (fixed points)
 
-    def __repr__(self):       # short ids in pytest output
+    def __repr__(self):  # short ids in pytest output
         return self.name
 
 
@@ -54,7 +55,7 @@ def _polys(geom) -> list[Polygon]:
 
 def shapely_case(name: str, geom, size: float) -> Case:
     """A Case from a shapely Polygon / MultiPolygon or a list of polygons."""
-    edges, verts, holes = [], [], []
+    edges, holes = [], []
     for poly in _polys(geom):
         for ring in [poly.exterior, *poly.interiors]:
             edges += _ring_edges(ring.coords)
@@ -76,18 +77,28 @@ def triangle_sample(name: str, size: float | None = None) -> Case:
     S = np.asarray(d["segments"])
     E = np.stack([V[S[:, 0]], V[S[:, 1]]], axis=1)
     # area: Triangle's own constrained triangulation of the same PSLG
-    ref = triangle.triangulate({k: d[k] for k in ("vertices", "segments", "holes")
-                                if k in d}, "p")
+    ref = triangle.triangulate({k: d[k] for k in ("vertices", "segments", "holes") if k in d}, "p")
     p = ref["vertices"][ref["triangles"]]
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])).sum()
+    area = (
+        0.5
+        * np.abs(
+            (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+            - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+        ).sum()
+    )
     on_segment = np.zeros(len(V), dtype=bool)
     on_segment[S.ravel()] = True
     L = np.linalg.norm(E[:, 1] - E[:, 0], axis=1)
-    return Case(f"poly:{name}", d, float(area), E, V,
-                float(np.median(L)) if size is None else size,
-                np.asarray(d.get("holes", np.zeros((0, 2)))).reshape(-1, 2),
-                isolated=int((~on_segment).sum()))
+    return Case(
+        f"poly:{name}",
+        d,
+        float(area),
+        E,
+        V,
+        float(np.median(L)) if size is None else size,
+        np.asarray(d.get("holes", np.zeros((0, 2)))).reshape(-1, 2),
+        isolated=int((~on_segment).sum()),
+    )
 
 
 def square():
@@ -122,8 +133,13 @@ def thin_channel():
 def serpentine():
     """A meandering orthogonal channel of width 0.1."""
     w = 0.1
-    parts = [box(0, 0, 3, w), box(3 - w, 0, 3, 1), box(0, 1 - w, 3, 1),
-             box(0, 1 - w, w, 2), box(0, 2 - w, 3, 2)]
+    parts = [
+        box(0, 0, 3, w),
+        box(3 - w, 0, 3, 1),
+        box(0, 1 - w, 3, 1),
+        box(0, 1 - w, w, 2),
+        box(0, 2 - w, 3, 2),
+    ]
     return shapely_case("serpentine", shapely.union_all(parts), 0.15)
 
 
@@ -144,16 +160,18 @@ def many_holes(k=4, kind="square"):
 
 def hole_touching_boundary(on_vertex=True):
     """A triangular hole one of whose vertices lies on the exterior ring."""
-    ext = [(0, 0), (2, 0), (4, 0), (4, 4), (0, 4)] if on_vertex else \
-        [(0, 0), (4, 0), (4, 4), (0, 4)]
+    ext = (
+        [(0, 0), (2, 0), (4, 0), (4, 4), (0, 4)] if on_vertex else [(0, 0), (4, 0), (4, 4), (0, 4)]
+    )
     poly = Polygon(ext, [[(2, 0), (3, 2), (1, 2)]])
     assert poly.is_valid
     return shapely_case("hole-touch-" + ("vertex" if on_vertex else "edge"), poly, 0.5)
 
 
 def holes_touching_each_other():
-    poly = Polygon([(0, 0), (6, 0), (6, 4), (0, 4)],
-                   [[(1, 1), (3, 2), (1, 3)], [(3, 2), (5, 1), (5, 3)]])
+    poly = Polygon(
+        [(0, 0), (6, 0), (6, 4), (0, 4)], [[(1, 1), (3, 2), (1, 3)], [(3, 2), (5, 1), (5, 3)]]
+    )
     assert poly.is_valid
     return shapely_case("holes-touch", poly, 0.5)
 
@@ -197,8 +215,10 @@ def narrow_slot():
 def spiral():
     th = np.linspace(0, 4 * np.pi, 80)
     inner, outer = 1 + th, 1.5 + th
-    ring = np.r_[np.c_[inner * np.cos(th), inner * np.sin(th)],
-                 np.c_[outer * np.cos(th), outer * np.sin(th)][::-1]]
+    ring = np.r_[
+        np.c_[inner * np.cos(th), inner * np.sin(th)],
+        np.c_[outer * np.cos(th), outer * np.sin(th)][::-1],
+    ]
     poly = Polygon(ring)
     assert poly.is_valid
     return shapely_case("spiral", poly, 0.3)
@@ -210,17 +230,40 @@ def sliver():
 
 
 def shapely_cases() -> list[Case]:
-    return [square(), regular_polygon(), l_shape(), comb(), thin_channel(), serpentine(),
-            many_holes(3, "square"), many_holes(4, "circle"), hole_touching_boundary(True),
-            hole_touching_boundary(False), holes_touching_each_other(),
-            corner_touching_parts(), vertex_on_edge_parts(), annulus(), far_from_origin(),
-            tiny_annulus(), narrow_slot(), spiral(), sliver()]
+    return [
+        square(),
+        regular_polygon(),
+        l_shape(),
+        comb(),
+        thin_channel(),
+        serpentine(),
+        many_holes(3, "square"),
+        many_holes(4, "circle"),
+        hole_touching_boundary(True),
+        hole_touching_boundary(False),
+        holes_touching_each_other(),
+        corner_touching_parts(),
+        vertex_on_edge_parts(),
+        annulus(),
+        far_from_origin(),
+        tiny_annulus(),
+        narrow_slot(),
+        spiral(),
+        sliver(),
+    ]
 
 
 # Triangle's sample files that describe closed domains (box.poly has an unclosed
 # segment and only a hole-filled square: nothing for aftmesh to mesh, tested apart).
-TRIANGLE_SAMPLES = ["A", "double_hex", "double_hex2", "double_hex3", "face", "la",
-                    "square_circle_hole"]
+TRIANGLE_SAMPLES = [
+    "A",
+    "double_hex",
+    "double_hex2",
+    "double_hex3",
+    "face",
+    "la",
+    "square_circle_hole",
+]
 
 
 # --------------------------------------------------------------- hypothesis domains
@@ -280,15 +323,17 @@ def incircle_signs(P: np.ndarray, quads: np.ndarray) -> np.ndarray:
     q = P[quads]
     d = q[:, 3:4, :]
     r = q[:, :3, :] - d
-    lift = (r ** 2).sum(axis=2)
+    lift = (r**2).sum(axis=2)
     x, y = r[..., 0], r[..., 1]
     m0 = x[:, 1] * y[:, 2] - x[:, 2] * y[:, 1]
     m1 = x[:, 2] * y[:, 0] - x[:, 0] * y[:, 2]
     m2 = x[:, 0] * y[:, 1] - x[:, 1] * y[:, 0]
     det = lift[:, 0] * m0 + lift[:, 1] * m1 + lift[:, 2] * m2
-    perm = (lift[:, 0] * (np.abs(x[:, 1] * y[:, 2]) + np.abs(x[:, 2] * y[:, 1]))
-            + lift[:, 1] * (np.abs(x[:, 2] * y[:, 0]) + np.abs(x[:, 0] * y[:, 2]))
-            + lift[:, 2] * (np.abs(x[:, 0] * y[:, 1]) + np.abs(x[:, 1] * y[:, 0])))
+    perm = (
+        lift[:, 0] * (np.abs(x[:, 1] * y[:, 2]) + np.abs(x[:, 2] * y[:, 1]))
+        + lift[:, 1] * (np.abs(x[:, 2] * y[:, 0]) + np.abs(x[:, 0] * y[:, 2]))
+        + lift[:, 2] * (np.abs(x[:, 0] * y[:, 1]) + np.abs(x[:, 1] * y[:, 0]))
+    )
     sign = np.sign(det).astype(int)
     unsure = np.abs(det) <= 1e-9 * perm
     for i in np.flatnonzero(unsure):
@@ -349,8 +394,10 @@ def assert_cdt(mesh) -> None:
     if ours <= theirs:
         return
     bad = non_delaunay_edges(mesh)
-    assert not bad, (f"{len(ours - theirs)} triangles are not in Triangle's CDT and "
-                     f"{len(bad)} edges fail the exact empty-circle test, e.g. {bad[:3]}")
+    assert not bad, (
+        f"{len(ours - theirs)} triangles are not in Triangle's CDT and "
+        f"{len(bad)} edges fail the exact empty-circle test, e.g. {bad[:3]}"
+    )
 
 
 def coordinate_keys(points) -> set:
@@ -381,7 +428,7 @@ def points_on_edges(points, edges, tol=1e-12) -> np.ndarray:
     E = np.asarray(edges, dtype=float)
     a, b = E[:, 0], E[:, 1]
     d = b - a
-    L2 = (d ** 2).sum(axis=1)
+    L2 = (d**2).sum(axis=1)
     rel = P[:, None, :] - a[None]
     t = (rel * d[None]).sum(axis=2) / L2[None]
     cross = rel[..., 0] * d[None, :, 1] - rel[..., 1] * d[None, :, 0]

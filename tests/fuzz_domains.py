@@ -18,6 +18,7 @@ Used by ``tests/test_robustness.py`` (hypothesis, ``ci`` / ``long`` profiles) an
   ``max_triangles`` respected, and the constrained Delaunay property against Triangle
   (exact empty-circle test where Triangle's choice differs on cocircular points).
 """
+
 from __future__ import annotations
 
 import json
@@ -30,23 +31,34 @@ import time
 import traceback
 from dataclasses import dataclass, field
 from fractions import Fraction
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 import shapely
 import triangle
 from hypothesis import assume
 from hypothesis import strategies as st
-from shapely.geometry import (GeometryCollection, LineString, MultiPolygon, Point,
-                              Polygon, box)
+from shapely.geometry import GeometryCollection, LineString, MultiPolygon, Point, Polygon, box
 
 import aftmesh
 from aftmesh import _kernel
 from aftmesh.checks import check_mesh
 
-__all__ = ["FuzzCase", "OracleError", "fuzz_cases", "verify", "run_case",
-           "case_to_json", "case_from_json", "size_callable", "GENERATORS",
-           "isolated", "Hang", "Crash", "ChildInterrupted"]
+__all__ = [
+    "FuzzCase",
+    "OracleError",
+    "fuzz_cases",
+    "verify",
+    "run_case",
+    "case_to_json",
+    "case_from_json",
+    "size_callable",
+    "GENERATORS",
+    "isolated",
+    "Hang",
+    "Crash",
+    "ChildInterrupted",
+]
 
 
 # ============================================================ isolation from crashes
@@ -70,27 +82,33 @@ def isolated(fn, *args, timeout: float = 30.0, memory_gb: float | None = None, *
     thus fails one test instead of taking the whole run down."""
     r, w = os.pipe()
     pid = os.fork()
-    if pid == 0:                                   # the child
+    if pid == 0:  # the child
         code = 0
         try:
             os.close(r)
             if memory_gb:
                 import resource
-                lim = int(memory_gb * 2 ** 30)
+
+                lim = int(memory_gb * 2**30)
                 resource.setrlimit(resource.RLIMIT_AS, (lim, lim))
             try:
                 out = ("ok", fn(*args, **kwargs))
-            except BaseException as exc:           # noqa: BLE001 - sent to the parent
+            except BaseException as exc:  # noqa: BLE001 - sent to the parent
                 out = ("raised", exc, traceback.format_exc())
             try:
                 data = pickle.dumps(out)
-            except Exception:                      # noqa: BLE001
+            except Exception:  # noqa: BLE001
                 exc = out[1] if out[0] == "raised" else None
-                data = pickle.dumps(("raised", RuntimeError(f"unpicklable result: {exc!r}"),
-                                     out[2] if len(out) > 2 else ""))
+                data = pickle.dumps(
+                    (
+                        "raised",
+                        RuntimeError(f"unpicklable result: {exc!r}"),
+                        out[2] if len(out) > 2 else "",
+                    )
+                )
             with os.fdopen(w, "wb") as f:
                 f.write(data)
-        except BaseException:                      # noqa: BLE001
+        except BaseException:  # noqa: BLE001
             code = 3
         finally:
             os._exit(code)
@@ -114,11 +132,15 @@ def isolated(fn, *args, timeout: float = 30.0, memory_gb: float | None = None, *
     _, status = os.waitpid(pid, 0)
     if os.WIFSIGNALED(status):
         sig = os.WTERMSIG(status)
-        raise Crash(f"{getattr(fn, '__name__', fn)} killed its process with signal "
-                    f"{sig} ({signal.Signals(sig).name})")
+        raise Crash(
+            f"{getattr(fn, '__name__', fn)} killed its process with signal "
+            f"{sig} ({signal.Signals(sig).name})"
+        )
     if not chunks:
-        raise Crash(f"{getattr(fn, '__name__', fn)}: the child exited with status "
-                    f"{os.waitstatus_to_exitcode(status)} without an answer")
+        raise Crash(
+            f"{getattr(fn, '__name__', fn)}: the child exited with status "
+            f"{os.waitstatus_to_exitcode(status)} without an answer"
+        )
     out = pickle.loads(b"".join(chunks))
     if out[0] == "ok":
         return out[1]
@@ -147,19 +169,23 @@ def size_callable(spec):
         # lo at the centre, growing linearly (slope >= 0.1, so the number of triangles
         # grows only with log(hi / lo)) up to hi
         slope = float(spec["slope"])
+
         def size(x, y):
             d = np.hypot(np.asarray(x) - cx, np.asarray(y) - cy)
             return np.minimum(hi, lo + slope * d)
     elif kind == "ramp":
         # linear in x across the domain's width
         x0, w = float(spec["x0"]), float(spec["width"])
+
         def size(x, y):
             t = np.clip((np.asarray(x, dtype=float) - x0) / w, 0.0, 1.0)
             return lo + (hi - lo) * t + 0.0 * np.asarray(y)
     elif kind == "wave":
         # between lo and hi in both directions, several periods over the domain
         def size(x, y):
-            s = np.sin(np.asarray(x) * 2 * np.pi / reach) * np.cos(np.asarray(y) * 2 * np.pi / reach)
+            s = np.sin(np.asarray(x) * 2 * np.pi / reach) * np.cos(
+                np.asarray(y) * 2 * np.pi / reach
+            )
             return lo * (hi / lo) ** (0.5 + 0.5 * s)
     else:
         raise KeyError(kind)
@@ -181,15 +207,18 @@ def size_specs(draw, bounds):
         return hi
     if kind == "point":
         ratio = 10.0 ** -draw(st.floats(0.0, 4.0))
-        return {"kind": "point", "lo": hi * ratio, "hi": hi,
-                "center": [draw(st.floats(x0, x1)), draw(st.floats(y0, y1))],
-                "slope": draw(st.floats(0.1, 1.0))}
+        return {
+            "kind": "point",
+            "lo": hi * ratio,
+            "hi": hi,
+            "center": [draw(st.floats(x0, x1)), draw(st.floats(y0, y1))],
+            "slope": draw(st.floats(0.1, 1.0)),
+        }
     if kind == "ramp":
         # fine along a whole side: kept to two orders of magnitude (the mesh has
         # (width / lo) triangles along that side)
         ratio = 10.0 ** -draw(st.floats(0.0, 2.0))
-        return {"kind": "ramp", "lo": hi * ratio, "hi": hi, "x0": x0,
-                "width": max(x1 - x0, 1e-300)}
+        return {"kind": "ramp", "lo": hi * ratio, "hi": hi, "x0": x0, "width": max(x1 - x0, 1e-300)}
     hi = diam * draw(st.floats(0.1, 0.4))
     ratio = 10.0 ** -draw(st.floats(0.0, 1.0))
     return {"kind": "wave", "lo": hi * ratio, "hi": hi, "reach": diam * draw(st.floats(0.2, 1.0))}
@@ -207,9 +236,9 @@ class FuzzCase:
     domain: object
     size: object = None
     options: dict = field(default_factory=dict)
-    polygons: list = field(default_factory=list)     # region polygons (or the parts)
-    lines: list = field(default_factory=list)        # constraint LineStrings
-    points: list = field(default_factory=list)       # fixed Points
+    polygons: list = field(default_factory=list)  # region polygons (or the parts)
+    lines: list = field(default_factory=list)  # constraint LineStrings
+    points: list = field(default_factory=list)  # fixed Points
 
     def call(self):
         return aftmesh.generate(self.domain, size_callable(self.size), **self.options)
@@ -233,18 +262,25 @@ def case_to_json(case: FuzzCase) -> dict:
     if isinstance(dom, shapely.Geometry):
         form = {"form": "geometry", "geometry": _geom_json(dom)}
     elif isinstance(dom, dict):
-        form = {"form": "dict", "vertices": np.asarray(dom["vertices"]).tolist(),
-                "segments": np.asarray(dom["segments"]).tolist(),
-                "holes": np.asarray(dom.get("holes", np.zeros((0, 2)))).tolist()}
+        form = {
+            "form": "dict",
+            "vertices": np.asarray(dom["vertices"]).tolist(),
+            "segments": np.asarray(dom["segments"]).tolist(),
+            "holes": np.asarray(dom.get("holes", np.zeros((0, 2)))).tolist(),
+        }
     elif isinstance(dom, np.ndarray):
         form = {"form": "ring", "coords": dom.tolist()}
     else:
         form = {"form": "regions", "items": [_geom_json(p) for p in dom]}
-    return {"kind": case.kind, "domain": form, "size": case.size,
-            "options": case.options,
-            "polygons": [_geom_json(p) for p in case.polygons],
-            "lines": [_geom_json(g) for g in case.lines],
-            "points": [_geom_json(g) for g in case.points]}
+    return {
+        "kind": case.kind,
+        "domain": form,
+        "size": case.size,
+        "options": case.options,
+        "polygons": [_geom_json(p) for p in case.polygons],
+        "lines": [_geom_json(g) for g in case.lines],
+        "points": [_geom_json(g) for g in case.points],
+    }
 
 
 def case_from_json(d: dict) -> FuzzCase:
@@ -252,17 +288,24 @@ def case_from_json(d: dict) -> FuzzCase:
     if f["form"] == "geometry":
         dom = _geom_from(f["geometry"])
     elif f["form"] == "dict":
-        dom = {"vertices": np.array(f["vertices"], dtype=float).reshape(-1, 2),
-               "segments": np.array(f["segments"], dtype=np.int64).reshape(-1, 2),
-               "holes": np.array(f["holes"], dtype=float).reshape(-1, 2)}
+        dom = {
+            "vertices": np.array(f["vertices"], dtype=float).reshape(-1, 2),
+            "segments": np.array(f["segments"], dtype=np.int64).reshape(-1, 2),
+            "holes": np.array(f["holes"], dtype=float).reshape(-1, 2),
+        }
     elif f["form"] == "ring":
         dom = np.array(f["coords"], dtype=float)
     else:
         dom = [_geom_from(g) for g in f["items"]]
-    return FuzzCase(d["kind"], dom, d["size"], dict(d["options"]),
-                    [_geom_from(g) for g in d["polygons"]],
-                    [_geom_from(g) for g in d["lines"]],
-                    [_geom_from(g) for g in d["points"]])
+    return FuzzCase(
+        d["kind"],
+        dom,
+        d["size"],
+        dict(d["options"]),
+        [_geom_from(g) for g in d["polygons"]],
+        [_geom_from(g) for g in d["lines"]],
+        [_geom_from(g) for g in d["points"]],
+    )
 
 
 def dumps(case: FuzzCase) -> str:
@@ -319,7 +362,7 @@ def _merge_straight(c: np.ndarray, closed: bool) -> np.ndarray:
         changed = False
         n = len(c)
         keep = np.ones(n, dtype=bool)
-        for i in (range(n) if closed else range(1, n - 1)):
+        for i in range(n) if closed else range(1, n - 1):
             a, b, d = c[i - 1], c[i], c[(i + 1) % n]
             if keep[i - 1] and _exact_orient(a, b, d) == 0 and np.dot(b - a, d - b) > 0:
                 keep[i] = False
@@ -384,10 +427,10 @@ def _dist_to_edges(pts: np.ndarray, E: np.ndarray, chunk: int = 256) -> np.ndarr
     L2 = np.maximum((d * d).sum(axis=1), 1e-300)
     best = np.full(len(pts), np.inf)
     for s in range(0, len(pts), chunk):
-        p = pts[s:s + chunk, None, :]
+        p = pts[s : s + chunk, None, :]
         t = np.clip(((p - a) * d).sum(axis=2) / L2, 0.0, 1.0)
         q = a + t[..., None] * d
-        best[s:s + chunk] = np.sqrt(((p - q) ** 2).sum(axis=2)).min(axis=1)
+        best[s : s + chunk] = np.sqrt(((p - q) ** 2).sum(axis=2)).min(axis=1)
     return best
 
 
@@ -422,7 +465,7 @@ def check_cdt_with_triangle(mesh, holes: np.ndarray) -> None:
     and segments, unless it has a neighbour across a non-segment edge whose far vertex
     is exactly on its circumcircle (cocircular points: the CDT is not unique there;
     check_mesh has already done the exact empty-circle test on every edge)."""
-    P = np.array(mesh.points, dtype=float)          # writable copies for Triangle
+    P = np.array(mesh.points, dtype=float)  # writable copies for Triangle
     T = np.array(mesh.triangles)
     S = np.array(mesh.segments, dtype=np.int32)
     if len(T) == 0:
@@ -432,8 +475,10 @@ def check_cdt_with_triangle(mesh, holes: np.ndarray) -> None:
         tri_in["holes"] = holes
     ref = triangle.triangulate(tri_in, "p")
     if len(ref["vertices"]) != len(P):
-        raise OracleError(f"Triangle had to add {len(ref['vertices']) - len(P)} points to "
-                          "this mesh's segments: mesh segments cross or touch")
+        raise OracleError(
+            f"Triangle had to add {len(ref['vertices']) - len(P)} points to "
+            "this mesh's segments: mesh segments cross or touch"
+        )
     theirs = {tuple(sorted(t)) for t in np.asarray(ref.get("triangles", [])).tolist()}
     extra = [i for i, t in enumerate(T.tolist()) if tuple(sorted(t)) not in theirs]
     if not extra:
@@ -458,8 +503,10 @@ def check_cdt_with_triangle(mesh, holes: np.ndarray) -> None:
     unexplained = [i for i in extra if i not in ok]
     if unexplained:
         i = unexplained[0]
-        raise OracleError(f"{len(unexplained)} triangles are not in Triangle's CDT and have "
-                          f"no cocircular neighbour, e.g. {P[T[i]].tolist()}")
+        raise OracleError(
+            f"{len(unexplained)} triangles are not in Triangle's CDT and have "
+            f"no cocircular neighbour, e.g. {P[T[i]].tolist()}"
+        )
 
 
 def area_tolerance(case: FuzzCase, area: float) -> float:
@@ -501,13 +548,16 @@ def verify(mesh, case: FuzzCase, check=check_mesh) -> None:
         tol = 1e-9 * span + 4e-16 * scale
         if (dist > tol).any():
             i = int(np.argmax(dist))
-            raise OracleError(f"mesh segment point {ends[i].tolist()} is {dist[i]:.3g} away "
-                              "from every input edge")
+            raise OracleError(
+                f"mesh segment point {ends[i].tolist()} is {dist[i]:.3g} away from every input edge"
+            )
         for a, b in E:
             short = _uncovered(P[S[:, 0]], P[S[:, 1]], a, b, tol)
             if short > 1e-9 * float(np.hypot(*(b - a))) + 2 * tol:
-                raise OracleError(f"input edge {a.tolist()} -> {b.tolist()} is not covered by "
-                                  f"mesh segments over a length of {short:.3g}")
+                raise OracleError(
+                    f"input edge {a.tolist()} -> {b.tolist()} is not covered by "
+                    f"mesh segments over a length of {short:.3g}"
+                )
     if not split and not case.lines:
         _check_unsplit(mesh, case, have)
     # regions: each triangle's centroid is inside the region it is labelled with
@@ -521,8 +571,10 @@ def verify(mesh, case: FuzzCase, check=check_mesh) -> None:
             # beyond: decide those by the exact centroid
             for i in out:
                 if not _exact_winding_inside(poly, P[np.asarray(mesh.triangles)[i]]):
-                    raise OracleError(f"a triangle labelled region {k} is not inside it: "
-                                      f"{P[np.asarray(mesh.triangles)[i]].tolist()}")
+                    raise OracleError(
+                        f"a triangle labelled region {k} is not inside it: "
+                        f"{P[np.asarray(mesh.triangles)[i]].tolist()}"
+                    )
         if ((reg < 0) | (reg >= len(case.polygons))).any():
             raise OracleError(f"region labels {np.unique(reg).tolist()} out of range")
     if swaps:
@@ -534,6 +586,7 @@ def _exact_winding_inside(poly, corners) -> bool:
     its rings around the point, in rational arithmetic (independent of the even-odd
     test aftmesh uses for the same question)."""
     from fractions import Fraction
+
     px = sum(Fraction(float(v)) for v in corners[:, 0]) / 3
     py = sum(Fraction(float(v)) for v in corners[:, 1]) / 3
     winding = 0
@@ -565,32 +618,42 @@ def _check_unsplit(mesh, case: FuzzCase, have: set) -> None:
         if key in segs:
             continue
         d = b - a
-        between = [p for p in V if np.dot(p - a, d) > 0 and np.dot(p - b, -d) > 0
-                   and _exact_orient(a, b, p) == 0]
+        between = [
+            p
+            for p in V
+            if np.dot(p - a, d) > 0 and np.dot(p - b, -d) > 0 and _exact_orient(a, b, p) == 0
+        ]
         if not between:
-            raise OracleError(f"input edge {a.tolist()} -> {b.tolist()} is not a mesh segment "
-                              "although split_boundary=False")
+            raise OracleError(
+                f"input edge {a.tolist()} -> {b.tolist()} is not a mesh segment "
+                "although split_boundary=False"
+            )
     if case.options.get("greedy"):
         inputs = {tuple(p) for p in V.tolist()}
         inputs |= {tuple(np.asarray(p.coords, dtype=float)[0, :2].tolist()) for p in case.points}
         extra = have - inputs
         if extra:
-            raise OracleError(f"greedy with split_boundary=False added {len(extra)} points, "
-                              f"e.g. {sorted(extra)[0]}")
+            raise OracleError(
+                f"greedy with split_boundary=False added {len(extra)} points, "
+                f"e.g. {sorted(extra)[0]}"
+            )
 
 
 def acceptable_refusal(case: FuzzCase, exc: BaseException) -> bool:
     """Refusals that are right for a valid domain: max_triangles below what the
     boundary alone needs (formula (3)); a size finer than the coordinates can
     resolve; coordinates far outside the range of the exact predicates."""
-    if (isinstance(exc, aftmesh.InvalidSizeError)
-            and case.options.get("max_triangles") is not None
-            and "triangles" in str(exc)):
+    if (
+        isinstance(exc, aftmesh.InvalidSizeError)
+        and case.options.get("max_triangles") is not None
+        and "triangles" in str(exc)
+    ):
         return True
     # a size finer than the coordinates resolve (sizing.MIN_SIZE_ULPS of their
     # spacing), refused as such: only when the case's smallest size really is
     if isinstance(exc, aftmesh.InvalidSizeError) and "coordinates can resolve" in str(exc):
         from aftmesh.sizing import MIN_SIZE_ULPS
+
         spec = case.size
         smallest = float(spec["lo"]) if isinstance(spec, dict) else spec
         mag = max(float(np.abs(np.asarray(p.bounds)).max()) for p in case.polygons)
@@ -625,13 +688,13 @@ def _finite_floats(lo, hi):
     make the exact predicates underflow, a known limit pinned once in
     test_regressions.py, which would otherwise drown every other failure."""
     tiny = 1e-12 * max(abs(lo), abs(hi), hi - lo)
-    return st.floats(lo, hi, allow_nan=False, allow_infinity=False,
-                     allow_subnormal=False).map(lambda v: 0.0 if abs(v) < tiny else v)
+    return st.floats(lo, hi, allow_nan=False, allow_infinity=False, allow_subnormal=False).map(
+        lambda v: 0.0 if abs(v) < tiny else v
+    )
 
 
 def _valid(g) -> bool:
-    return (isinstance(g, (Polygon, MultiPolygon)) and not g.is_empty and g.is_valid
-            and g.area > 0)
+    return isinstance(g, (Polygon, MultiPolygon)) and not g.is_empty and g.is_valid and g.area > 0
 
 
 @st.composite
@@ -650,8 +713,10 @@ def star_polygons(draw, max_vertices=40):
 
 def _cross(p, q, r, s) -> bool:
     """Whether the open segments pq and rs cross (float orientation, general position)."""
+
     def o(a, b, c):
         return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
     return (o(p, q, r) * o(p, q, s) < 0) and (o(r, s, p) * o(r, s, q) < 0)
 
 
@@ -669,7 +734,7 @@ def untangle(pts: np.ndarray) -> np.ndarray:
                 a, b = pts[order[i]], pts[order[i + 1]]
                 c, d = pts[order[j]], pts[order[(j + 1) % n]]
                 if _cross(a, b, c, d):
-                    order[i + 1:j + 1] = order[i + 1:j + 1][::-1]
+                    order[i + 1 : j + 1] = order[i + 1 : j + 1][::-1]
                     changed = True
         if not changed:
             break
@@ -696,8 +761,12 @@ def grid_unions(draw):
     assume(any(cells))
     sx = draw(_finite_floats(0.2, 3.0))
     sy = draw(_finite_floats(0.2, 3.0))
-    boxes = [box(i * sx, j * sy, (i + 1) * sx, (j + 1) * sy)
-             for i in range(k) for j in range(k) if cells[i * k + j]]
+    boxes = [
+        box(i * sx, j * sy, (i + 1) * sx, (j + 1) * sy)
+        for i in range(k)
+        for j in range(k)
+        if cells[i * k + j]
+    ]
     g = shapely.union_all(boxes)
     assume(_valid(g))
     return "cells", g
@@ -724,8 +793,15 @@ def many_holes(draw):
             r = min(cw, ch) * draw(_finite_floats(0.05, 0.4))
             jx = (cw / 2 - r) * draw(_finite_floats(-0.9, 0.9))
             jy = (ch / 2 - r) * draw(_finite_floats(-0.9, 0.9))
-            holes.append(_ngon((i + 0.5) * cw + jx, (j + 0.5) * ch + jy, r, m,
-                               draw(_finite_floats(0, 2 * np.pi))))
+            holes.append(
+                _ngon(
+                    (i + 0.5) * cw + jx,
+                    (j + 0.5) * ch + jy,
+                    r,
+                    m,
+                    draw(_finite_floats(0, 2 * np.pi)),
+                )
+            )
     assume(holes)
     poly = Polygon([(0, 0), (W, 0), (W, H), (0, H)], holes)
     assume(_valid(poly))
@@ -743,8 +819,10 @@ def touching(draw):
         hh = draw(_finite_floats(0.05, 0.9))
         w = draw(_finite_floats(0.1, 1.0))
         y = 1.0
-        holes = [[(w * k, y), (w * k + w / 2, y - hh), (w * (k + 1), y), (w * k + w / 2, y + hh)]
-                 for k in range(n)]
+        holes = [
+            [(w * k, y), (w * k + w / 2, y - hh), (w * (k + 1), y), (w * k + w / 2, y + hh)]
+            for k in range(n)
+        ]
         right = w * n + draw(_finite_floats(0.1, 1.0))
         if draw(st.booleans()):
             shell = [(0, 0), (right, 0), (right, 2), (0, 2)]
@@ -761,15 +839,23 @@ def touching(draw):
             a1 = a0 + draw(_finite_floats(0.3, 2 * np.pi / k - 0.2))
             r0 = draw(_finite_floats(0.05, 0.25))
             r1 = draw(_finite_floats(0.05, 0.25))
-            holes.append([tuple(c), tuple(c + r0 * np.array([np.cos(a0), np.sin(a0)])),
-                          tuple(c + r1 * np.array([np.cos(a1), np.sin(a1)]))])
+            holes.append(
+                [
+                    tuple(c),
+                    tuple(c + r0 * np.array([np.cos(a0), np.sin(a0)])),
+                    tuple(c + r1 * np.array([np.cos(a1), np.sin(a1)])),
+                ]
+            )
         poly = Polygon([(0, 0), (1, 0), (1, 1), (0, 1)], holes)
     elif which == "notch":
         # a hole's vertex at a reflex vertex of the outer ring
         d = draw(_finite_floats(0.1, 0.8))
         shell = [(0, 0), (2, 0), (2, 2), (1, 2), (1, 2 - d), (1 - d / 2, 2), (0, 2)]
-        hole = [(1, 2 - d), (1.0 + draw(_finite_floats(0.1, 0.9)), 0.5),
-                (1.0 - draw(_finite_floats(0.1, 0.9)), 0.5)]
+        hole = [
+            (1, 2 - d),
+            (1.0 + draw(_finite_floats(0.1, 0.9)), 0.5),
+            (1.0 - draw(_finite_floats(0.1, 0.9)), 0.5),
+        ]
         poly = Polygon(shell, [hole])
     else:
         # rows of rectangles of random widths: shared edges with T-junctions
@@ -801,14 +887,23 @@ def nearly_touching(draw):
     elif which == "slot":
         depth = draw(_finite_floats(0.1, 0.9))
         x = draw(_finite_floats(0.2, 0.8))
-        g = Polygon([(0, 0), (1, 0), (1, 1), (x + gap, 1), (x + gap, 1 - depth),
-                     (x, 1 - depth), (x, 1), (0, 1)])
+        g = Polygon(
+            [
+                (0, 0),
+                (1, 0),
+                (1, 1),
+                (x + gap, 1),
+                (x + gap, 1 - depth),
+                (x, 1 - depth),
+                (x, 1),
+                (0, 1),
+            ]
+        )
     elif which == "parts":
         dy = draw(_finite_floats(-0.5, 0.5))
         g = MultiPolygon([box(0, 0, 1, 1), box(1 + gap, dy, 2, dy + 1)])
     else:
-        return "near-regions", [box(0, 0, 1, 1), box(1 + gap, 0, 2, 1),
-                                box(0, 1 + gap, 2, 2)]
+        return "near-regions", [box(0, 0, 1, 1), box(1 + gap, 0, 2, 1), box(0, 1 + gap, 2, 2)]
     assume(_valid(g))
     return f"near-{which}", g
 
@@ -830,8 +925,11 @@ def slivers_and_spikes(draw):
             t = 2 * np.pi * i / n
             if i in spikes:
                 R = draw(_finite_floats(1.5, 4.0))
-                pts += [(np.cos(t - eps), np.sin(t - eps)), (R * np.cos(t), R * np.sin(t)),
-                        (np.cos(t + eps), np.sin(t + eps))]
+                pts += [
+                    (np.cos(t - eps), np.sin(t - eps)),
+                    (R * np.cos(t), R * np.sin(t)),
+                    (np.cos(t + eps), np.sin(t + eps)),
+                ]
             else:
                 pts.append((np.cos(t), np.sin(t)))
         g = Polygon(pts)
@@ -843,8 +941,9 @@ def slivers_and_spikes(draw):
 def near_collinear(draw):
     """Extra vertices on the edges, off the line by 0, one ulp, or up to 1e-9 of the
     edge's length; repeated vertices (given twice in a row)."""
-    _, base = draw(st.one_of(star_polygons(max_vertices=8),
-                             st.just(("box", box(0.25, 0.25, 1.25, 0.95)))))
+    _, base = draw(
+        st.one_of(star_polygons(max_vertices=8), st.just(("box", box(0.25, 0.25, 1.25, 0.95))))
+    )
     c = _ring_coords(base.exterior)
     out = []
     for i in range(len(c)):
@@ -865,15 +964,15 @@ def near_collinear(draw):
                 p = p + float(off) * nrm
             out.append(p)
             if draw(st.integers(0, 4)) == 0:
-                out.append(p.copy())            # a repeated vertex
+                out.append(p.copy())  # a repeated vertex
     ring = np.array(out)
     if draw(st.booleans()):
-        ring = np.r_[ring, ring[:1], ring[:1]]   # closed, and the closing vertex twice
+        ring = np.r_[ring, ring[:1], ring[:1]]  # closed, and the closing vertex twice
     assume(_valid(Polygon(ring)))
     return "collinear", ring
 
 
-@lru_cache(maxsize=None)
+@cache
 def lattice_circle(R: int) -> np.ndarray:
     """All integer points on the circle x^2 + y^2 = R^2, sorted by angle: exactly
     cocircular in floating point."""
@@ -896,17 +995,19 @@ def cocircular(draw):
         shell = _ngon(0.0, 0.0, 1.0, n, draw(_finite_floats(0, 1)))
         holes = []
         if draw(st.booleans()):
-            holes = [_ngon(0.0, 0.0, draw(_finite_floats(0.2, 0.8)), draw(st.integers(3, 400)), 0.0)]
+            holes = [
+                _ngon(0.0, 0.0, draw(_finite_floats(0.2, 0.8)), draw(st.integers(3, 400)), 0.0)
+            ]
         g = Polygon(shell, holes)
         kind = "regular"
     else:
-        R = draw(st.sampled_from([5525, 32045]))      # 180 and 324 lattice points
+        R = draw(st.sampled_from([5525, 32045]))  # 180 and 324 lattice points
         P = lattice_circle(R)
         keep = draw(st.lists(st.booleans(), min_size=len(P), max_size=len(P)))
         shell = P[np.array(keep)] if sum(keep) >= 3 else P
         holes = []
         if draw(st.booleans()):
-            holes = [lattice_circle(1105)]             # 32 points, same centre
+            holes = [lattice_circle(1105)]  # 32 points, same centre
         g = Polygon(shell, holes)
         kind = "lattice"
     assume(_valid(g))
@@ -941,8 +1042,11 @@ def with_constraints(draw):
         end = a if draw(st.booleans()) else a + draw(_finite_floats(0.1, 0.9)) * (b - a)
         q = (draw(_finite_floats(x0, x1)), draw(_finite_floats(y0, y1)))
         line = LineString([q, tuple(end)])
-        if inner.contains(Point(q)) and line.length > 0 and \
-                line.difference(poly).length <= 1e-9 * line.length:
+        if (
+            inner.contains(Point(q))
+            and line.length > 0
+            and line.difference(poly).length <= 1e-9 * line.length
+        ):
             lines.append(line)
     # fixed points on the lines
     for line in list(lines):
@@ -969,7 +1073,9 @@ def nested_regions(draw):
         if draw(st.booleans()):
             regions.append(Polygon(h))
     y0 = draw(_finite_floats(0.0, H / 2))
-    regions.append(box(W, y0, W + draw(_finite_floats(0.3, 2.0)), y0 + draw(_finite_floats(0.2, H))))
+    regions.append(
+        box(W, y0, W + draw(_finite_floats(0.3, 2.0)), y0 + draw(_finite_floats(0.2, H)))
+    )
     assume(all(_valid(r) for r in regions))
     return "nested-regions", regions
 
@@ -981,7 +1087,7 @@ def extreme_scales(draw):
     mesh or an InvalidInputError about the coordinates."""
     _, g = draw(st.one_of(star_polygons(max_vertices=12), many_holes(), grid_unions()))
     k = draw(st.integers(-70, 80))
-    scale = 10.0 ** k
+    scale = 10.0**k
     g = shapely.transform(g, lambda c: c * scale)
     assume(_valid(g))
     return "extreme", g
@@ -1034,8 +1140,7 @@ def options(draw, rich=True):
 
 
 @st.composite
-def fuzz_cases(draw, kinds=None, transform=True, forms=True, rich_options=False,
-               sizes=True):
+def fuzz_cases(draw, kinds=None, transform=True, forms=True, rich_options=False, sizes=True):
     """One FuzzCase: a domain from GENERATORS (`kinds` restricts), maybe moved by
     1e7 or scaled by 1e-6, in one of the accepted input forms, with a size spec and
     options."""
@@ -1056,8 +1161,11 @@ def fuzz_cases(draw, kinds=None, transform=True, forms=True, rich_options=False,
         polys = [geom]
     tf = draw(st.sampled_from(["none", "none", "offset", "small"])) if transform else "none"
     if tf != "none":
-        scale, off = (1.0, np.array([1e7, -1e7]) * draw(_finite_floats(1.0, 9.0))) \
-            if tf == "offset" else (1e-6 * draw(_finite_floats(1.0, 9.0)), np.zeros(2))
+        scale, off = (
+            (1.0, np.array([1e7, -1e7]) * draw(_finite_floats(1.0, 9.0)))
+            if tf == "offset"
+            else (1e-6 * draw(_finite_floats(1.0, 9.0)), np.zeros(2))
+        )
         if isinstance(geom, np.ndarray):
             geom = geom * scale + off
         elif isinstance(geom, list):
@@ -1093,7 +1201,10 @@ def fuzz_cases(draw, kinds=None, transform=True, forms=True, rich_options=False,
 
 def _bounds(polys):
     b = np.array([p.bounds for p in polys])
-    return (float(b[:, 0].min()), float(b[:, 1].min())), (float(b[:, 2].max()), float(b[:, 3].max()))
+    return (float(b[:, 0].min()), float(b[:, 1].min())), (
+        float(b[:, 2].max()),
+        float(b[:, 3].max()),
+    )
 
 
 def _void_points(polys) -> np.ndarray:

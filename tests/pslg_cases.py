@@ -9,6 +9,7 @@ The inputs are in general position with probability one (random doubles): no fou
 points cocircular, no three collinear, and the segments do not cross (checked with a
 margin, so no pair is anywhere near crossing or touching).
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -18,12 +19,12 @@ from shapely.geometry import LineString, Point, Polygon
 
 def _orient(p, q, r):
     """Floating-point orientation of (p, q, r), broadcast over rows."""
-    return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - \
-        (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0])
+    return (q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1]) - (q[..., 1] - p[..., 1]) * (
+        r[..., 0] - p[..., 0]
+    )
 
 
-def add_noncrossing_segments(rng, pts, n_wanted, existing=(), k_near=12, margin=1e-9,
-                             allowed=None):
+def add_noncrossing_segments(rng, pts, n_wanted, existing=(), k_near=12, margin=1e-9, allowed=None):
     """Pick up to ``n_wanted`` segments between points of ``pts`` (pairs of a point and
     one of its ``k_near`` nearest neighbours) that neither cross nor nearly touch each
     other or the ``existing`` ones.  ``allowed(i, j)`` may veto a pair."""
@@ -50,14 +51,17 @@ def add_noncrossing_segments(rng, pts, n_wanted, existing=(), k_near=12, margin=
             scale = max(np.ptp(pts[:, 0]), np.ptp(pts[:, 1])) ** 2
             o1, o2 = _orient(p, q, a), _orient(p, q, b)
             o3, o4 = _orient(a, b, p), _orient(a, b, q)
-            near = (np.minimum.reduce([abs(o1), abs(o2), abs(o3), abs(o4)]) < margin * scale)
+            near = np.minimum.reduce([abs(o1), abs(o2), abs(o3), abs(o4)]) < margin * scale
             cross = (o1 * o2 < 0) & (o3 * o4 < 0)
             if ((cross | near) & ~shared).any():
                 continue
             # segments sharing an endpoint must not overlap (never with random points,
             # but be safe): the other ends must not be collinear with this one
-            if (shared & (np.minimum(abs(o1), abs(o2)) < margin * scale)
-                    & (np.maximum(abs(o1), abs(o2)) < margin * scale)).any():
+            if (
+                shared
+                & (np.minimum(abs(o1), abs(o2)) < margin * scale)
+                & (np.maximum(abs(o1), abs(o2)) < margin * scale)
+            ).any():
                 continue
         # no other point may lie (nearly) on the new segment
         p, q = pts[i], pts[j]
@@ -91,8 +95,13 @@ def random_points(rng, n, kind="uniform"):
         pts = np.c_[r * np.cos(a), r * np.sin(a)]
     else:
         raise ValueError(kind)
-    return dict(vertices=pts, segments=np.zeros((0, 2), np.int64), holes=np.zeros((0, 2)),
-                regions=np.zeros((0, 3)), area=None)
+    return dict(
+        vertices=pts,
+        segments=np.zeros((0, 2), np.int64),
+        holes=np.zeros((0, 2)),
+        regions=np.zeros((0, 3)),
+        area=None,
+    )
 
 
 def box_with_segments(rng, n_points, n_segments, k_near=12):
@@ -101,10 +110,12 @@ def box_with_segments(rng, n_points, n_segments, k_near=12):
     inner = 0.02 + 0.96 * rng.random((n_points, 2))
     pts = np.vstack([[(0, 0), (1, 0), (1, 1), (0, 1)], inner])
     ring = [(0, 1), (1, 2), (2, 3), (3, 0)]
-    segs = add_noncrossing_segments(rng, pts, n_segments, existing=ring, k_near=k_near,
-                                    allowed=lambda i, j: i >= 4 and j >= 4)
-    return dict(vertices=pts, segments=segs, holes=np.zeros((0, 2)), regions=np.zeros((0, 3)),
-                area=1.0)
+    segs = add_noncrossing_segments(
+        rng, pts, n_segments, existing=ring, k_near=k_near, allowed=lambda i, j: i >= 4 and j >= 4
+    )
+    return dict(
+        vertices=pts, segments=segs, holes=np.zeros((0, 2)), regions=np.zeros((0, 3)), area=1.0
+    )
 
 
 def star_ring(rng, centre, rmin, rmax, k):
@@ -156,7 +167,7 @@ def polygon_with_holes(rng, n_outer=None, n_inner_rings=None, n_points=None, n_e
     domain = Polygon(outer, [np.asarray(p.exterior.coords) for p in hole_polys])
     # random points in the outer ring's bounding disk, kept if strictly inside the
     # domain and well away from every ring
-    cand = (rng.random((4 * n_points + 10, 2)) * 2 - 1)
+    cand = rng.random((4 * n_points + 10, 2)) * 2 - 1
     rings_boundary = Polygon(outer).boundary
     for p in inner_polys:
         rings_boundary = rings_boundary.union(p.boundary)
@@ -180,18 +191,25 @@ def polygon_with_holes(rng, n_outer=None, n_inner_rings=None, n_points=None, n_e
                 return False
             return rings_geom.distance(LineString([pts[i], pts[j]])) > 1e-6
 
-        segs = [tuple(s) for s in add_noncrossing_segments(
-            rng, pts, n_extra_segments, existing=ring_segs, allowed=allowed)]
+        segs = [
+            tuple(s)
+            for s in add_noncrossing_segments(
+                rng, pts, n_extra_segments, existing=ring_segs, allowed=allowed
+            )
+        ]
     # region marker 1 for the part between the rings: a point of the domain minus the
     # inner rings
     between = Polygon(outer, [np.asarray(p.exterior.coords) for p in inner_polys])
     rp = between.representative_point()
     if rings_boundary.distance(rp) > 1e-6:
         regions.append((rp.x, rp.y, 1))
-    return dict(vertices=pts, segments=np.asarray(segs, dtype=np.int64).reshape(-1, 2),
-                holes=np.asarray(holes, dtype=np.float64).reshape(-1, 2),
-                regions=np.asarray(regions, dtype=np.float64).reshape(-1, 3),
-                area=domain.area)
+    return dict(
+        vertices=pts,
+        segments=np.asarray(segs, dtype=np.int64).reshape(-1, 2),
+        holes=np.asarray(holes, dtype=np.float64).reshape(-1, 2),
+        regions=np.asarray(regions, dtype=np.float64).reshape(-1, 3),
+        area=domain.area,
+    )
 
 
 def nested_rings(rng, depth=None, n_points=None):
@@ -216,8 +234,9 @@ def nested_rings(rng, depth=None, n_points=None):
     kept = []
     for d in range(depth):
         inner = rings[d + 1] if d + 1 < depth else None
-        annulus = Polygon(rings[d].exterior.coords,
-                          [inner.exterior.coords] if inner is not None else [])
+        annulus = Polygon(
+            rings[d].exterior.coords, [inner.exterior.coords] if inner is not None else []
+        )
         rp = annulus.representative_point()
         if d % 2 == 1 and inner is not None:
             holes.append((rp.x, rp.y))
@@ -237,6 +256,10 @@ def nested_rings(rng, depth=None, n_points=None):
         if any(a.contains(p) for a in kept) and boundary.distance(p) > 1e-3:
             pts_extra.append(xy)
     pts = np.vstack(verts + [np.asarray(pts_extra).reshape(-1, 2)])
-    return dict(vertices=pts, segments=np.asarray(segs, dtype=np.int64),
-                holes=np.asarray(holes, dtype=np.float64).reshape(-1, 2),
-                regions=np.asarray(regions, dtype=np.float64).reshape(-1, 3), area=area)
+    return dict(
+        vertices=pts,
+        segments=np.asarray(segs, dtype=np.int64),
+        holes=np.asarray(holes, dtype=np.float64).reshape(-1, 2),
+        regions=np.asarray(regions, dtype=np.float64).reshape(-1, 3),
+        area=area,
+    )

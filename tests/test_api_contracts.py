@@ -1,5 +1,6 @@
 """API contracts of ``aftmesh.generate`` that users build on: how the size callable is
 called, and what it must return."""
+
 import numpy as np
 import pytest
 from shapely.geometry import Point, box
@@ -18,6 +19,7 @@ def test_size_callable_receives_1d_arrays_of_equal_length(checked):
     def size(x, y):
         seen.append((np.ndim(x), np.ndim(y), np.shape(x) == np.shape(y)))
         return 0.05 + 0.1 * x
+
     checked(aftmesh.generate(SQUARE, size), domain_area=1.0)
     assert seen and all(s == (1, 1, True) for s in seen), seen
 
@@ -31,6 +33,7 @@ def test_size_from_a_kdtree_query_on_stacked_points(checked):
     def size(x, y):
         dist, _ = tree.query(np.c_[x, y])
         return 0.02 + 0.3 * dist
+
     mesh = checked(aftmesh.generate(SQUARE, size), domain_area=1.0)
     P = mesh.points
     e = mesh.edges
@@ -46,6 +49,7 @@ def test_size_callable_on_point_rows(checked):
     def h(points):
         assert points.ndim == 2 and points.shape[1] == 2
         return 0.04 + 0.1 * np.hypot(points[:, 0], points[:, 1])
+
     domain = box(0, 0, 2, 1).difference(Point(1.4, 0.5).buffer(0.2))
     checked(aftmesh.generate(domain, lambda x, y: h(np.c_[x, y])), domain_area=domain.area)
 
@@ -54,11 +58,14 @@ def test_size_callable_returning_a_scalar(checked):
     checked(aftmesh.generate(SQUARE, lambda x, y: 0.1), domain_area=1.0)
 
 
-@pytest.mark.parametrize("result, shape", [
-    (lambda x, y: np.c_[x, y][:, :1] * 0 + 0.1, "(n, 1)"),
-    (lambda x, y: np.full(3, 0.1), "(3,)"),
-    (lambda x, y: np.full((len(x), 2), 0.1), "(n, 2)"),
-])
+@pytest.mark.parametrize(
+    "result, shape",
+    [
+        (lambda x, y: np.c_[x, y][:, :1] * 0 + 0.1, "(n, 1)"),
+        (lambda x, y: np.full(3, 0.1), "(3,)"),
+        (lambda x, y: np.full((len(x), 2), 0.1), "(n, 2)"),
+    ],
+)
 def test_size_callable_of_the_wrong_shape_is_refused(result, shape):
     with pytest.raises(InvalidSizeError, match="shape .* 1-D arrays x, y of length"):
         aftmesh.generate(SQUARE, result)
@@ -71,6 +78,7 @@ def test_size_callable_values_identical_to_elementwise_grid():
     def size(x, y):
         calls.append(np.c_[x, y].copy())
         return 0.05 + 0.05 * x * y
+
     mesh = aftmesh.generate(SQUARE, size)
     field = mesh.info["size_field"]
     ny, nx = field.h.shape

@@ -14,15 +14,18 @@ Comparison rules:
 * The exact checks here use Python integers (every double is an integer times a power
   of two), independently of the kernel's predicates, which ``check_mesh`` relies on.
 """
+
 from __future__ import annotations
 
 import itertools
 import os
 
 import numpy as np
+import pslg_cases as pc
 import pytest
 import triangle
-from hypothesis import given, strategies as st
+from hypothesis import given
+from hypothesis import strategies as st
 from shapely.geometry import MultiPoint
 from triangle.data import get_data_dir
 
@@ -31,12 +34,10 @@ from aftmesh import _kernel
 from aftmesh.checks import check_mesh
 from aftmesh.errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 
-import pslg_cases as pc
-
-
 # --------------------------------------------------------------------------------------
 # exact arithmetic, independent of aftmesh
 # --------------------------------------------------------------------------------------
+
 
 def exact_ints(points):
     """The coordinates as Python ints, all scaled by one power of two (exactly)."""
@@ -55,8 +56,9 @@ def _signs(values):
 def exact_orient(Q, a, b, c):
     """Signs of orient2d for index arrays a, b, c into the exact points Q."""
     A, B, C = Q[a], Q[b], Q[c]
-    return _signs((B[:, 0] - A[:, 0]) * (C[:, 1] - A[:, 1])
-                  - (B[:, 1] - A[:, 1]) * (C[:, 0] - A[:, 0]))
+    return _signs(
+        (B[:, 0] - A[:, 0]) * (C[:, 1] - A[:, 1]) - (B[:, 1] - A[:, 1]) * (C[:, 0] - A[:, 0])
+    )
 
 
 def exact_incircle(Q, a, b, c, d):
@@ -66,9 +68,11 @@ def exact_incircle(Q, a, b, c, d):
     la = A[:, 0] * A[:, 0] + A[:, 1] * A[:, 1]
     lb = B[:, 0] * B[:, 0] + B[:, 1] * B[:, 1]
     lc = C[:, 0] * C[:, 0] + C[:, 1] * C[:, 1]
-    det = (la * (B[:, 0] * C[:, 1] - C[:, 0] * B[:, 1])
-           + lb * (C[:, 0] * A[:, 1] - A[:, 0] * C[:, 1])
-           + lc * (A[:, 0] * B[:, 1] - B[:, 0] * A[:, 1]))
+    det = (
+        la * (B[:, 0] * C[:, 1] - C[:, 0] * B[:, 1])
+        + lb * (C[:, 0] * A[:, 1] - A[:, 0] * C[:, 1])
+        + lc * (A[:, 0] * B[:, 1] - B[:, 0] * A[:, 1])
+    )
     return _signs(det)
 
 
@@ -100,8 +104,12 @@ def exact_report(points, triangles, constrained):
         inc = exact_incircle(Q, q[:, 0], q[:, 1], q[:, 2], q[:, 3])
     else:
         inc = np.zeros(0, dtype=np.int64)
-    return dict(not_ccw=int((orient <= 0).sum()), non_delaunay=int((inc > 0).sum()),
-                cocircular=int((inc == 0).sum()), overfull_edges=overfull)
+    return dict(
+        not_ccw=int((orient <= 0).sum()),
+        non_delaunay=int((inc > 0).sum()),
+        cocircular=int((inc == 0).sum()),
+        overfull_edges=overfull,
+    )
 
 
 def assert_exact_cdt(mesh):
@@ -116,6 +124,7 @@ def assert_exact_cdt(mesh):
 def exact_area(points, triangles):
     """The total area of the triangles, exactly (a Fraction)."""
     from fractions import Fraction
+
     T = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     P = np.asarray(points, dtype=np.float64)
     if len(T) == 0:
@@ -124,36 +133,50 @@ def exact_area(points, triangles):
     Q = np.empty(P.shape, dtype=object)
     Q[:] = 0
     used = np.unique(T)
-    Q[used] = exact_ints(P[used])           # scaled by the same power of two, den
+    Q[used] = exact_ints(P[used])  # scaled by the same power of two, den
     A, B, C = Q[T[:, 0]], Q[T[:, 1]], Q[T[:, 2]]
-    twice = ((B[:, 0] - A[:, 0]) * (C[:, 1] - A[:, 1])
-             - (B[:, 1] - A[:, 1]) * (C[:, 0] - A[:, 0])).sum()
+    twice = (
+        (B[:, 0] - A[:, 0]) * (C[:, 1] - A[:, 1]) - (B[:, 1] - A[:, 1]) * (C[:, 0] - A[:, 0])
+    ).sum()
     return Fraction(int(twice), 2 * den * den)
 
 
 def exact_polygon_area(coords):
     """Shoelace formula, exactly, for a closed ring given without its closing point."""
     from fractions import Fraction
+
     X = [(Fraction(float(x)), Fraction(float(y))) for x, y in coords]
-    return abs(sum(X[k][0] * X[(k + 1) % len(X)][1] - X[(k + 1) % len(X)][0] * X[k][1]
-                   for k in range(len(X)))) / 2
+    return (
+        abs(
+            sum(
+                X[k][0] * X[(k + 1) % len(X)][1] - X[(k + 1) % len(X)][0] * X[k][1]
+                for k in range(len(X))
+            )
+        )
+        / 2
+    )
 
 
 def signed_area(points, triangles):
     p = np.asarray(points)[np.asarray(triangles).reshape(-1, 3)]
-    return 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                  - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    return 0.5 * (
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
 
 
 # --------------------------------------------------------------------------------------
 # the oracle comparison
 # --------------------------------------------------------------------------------------
 
+
 def canonical_ids(vertices):
     """For each input vertex, the first input vertex with the same coordinates."""
     first: dict = {}
-    return np.array([first.setdefault((x, y), i)
-                     for i, (x, y) in enumerate(np.asarray(vertices).tolist())], dtype=np.int64)
+    return np.array(
+        [first.setdefault((x, y), i) for i, (x, y) in enumerate(np.asarray(vertices).tolist())],
+        dtype=np.int64,
+    )
 
 
 def output_to_input(mesh, n_in):
@@ -219,15 +242,16 @@ def cross_check(V, S=None, H=None, R=None, *, area=None, check_cover=False, mark
     S = _as(S, (-1, 2), np.int64)
     H = _as(H, (-1, 2), np.float64)
     R = _as(R, (-1, 3), np.float64)
-    mesh = aftmesh.cdt(V, S if len(S) else None, holes=H if len(H) else None,
-                       regions=R if len(R) else None)
-    check_mesh(mesh, domain_area=area,
-               input_segments=V[S] if (check_cover and len(S)) else None)
+    mesh = aftmesh.cdt(
+        V, S if len(S) else None, holes=H if len(H) else None, regions=R if len(R) else None
+    )
+    check_mesh(mesh, domain_area=area, input_segments=V[S] if (check_cover and len(S)) else None)
     assert_exact_cdt(mesh)
 
     ref = run_triangle(V, S, H, R)
-    assert ref["added_vertices"] == 0, \
+    assert ref["added_vertices"] == 0, (
         "Triangle added vertices: the test PSLG has crossing segments (test bug)"
+    )
     canon = canonical_ids(V)
     back = output_to_input(mesh, len(V))
     # the output points are exactly the input coordinates
@@ -253,8 +277,10 @@ def cross_check(V, S=None, H=None, R=None, *, area=None, check_cover=False, mark
         for (u, v), mk in zip(mesh.segments.tolist(), mesh.segment_markers.tolist()):
             our_segs[frozenset((int(canon[back[u]]), int(canon[back[v]])))] = mk + 2
         their_segs = {}
-        for (u, v), mk in zip(np.asarray(ref["segments"]).tolist(),
-                              np.asarray(ref.get("segment_markers", [])).ravel().tolist()):
+        for (u, v), mk in zip(
+            np.asarray(ref["segments"]).tolist(),
+            np.asarray(ref.get("segment_markers", [])).ravel().tolist(),
+        ):
             their_segs[frozenset((int(canon[u]), int(canon[v])))] = mk
         assert set(our_segs) == set(their_segs), "different constrained edges"
         assert len(our_segs) == len(mesh.segments), "a segment is listed twice"
@@ -272,8 +298,7 @@ def cross_check(V, S=None, H=None, R=None, *, area=None, check_cover=False, mark
         assert mesh.n_triangles == len(theirs_set)
     # the same domain: exactly the same area (floating-point sums of slivers are not
     # reliable enough for that)
-    assert exact_area(mesh.points, mesh.triangles) == exact_area(ref["vertices"],
-                                                                 ref["triangles"])
+    assert exact_area(mesh.points, mesh.triangles) == exact_area(ref["vertices"], ref["triangles"])
     if area is not None:
         assert mesh.area() == pytest.approx(area, rel=1e-9)
 
@@ -288,15 +313,17 @@ def cross_check(V, S=None, H=None, R=None, *, area=None, check_cover=False, mark
             our_areas = signed_area(mesh.points, mesh.triangles)
             for mk in set(attrs.astype(int).tolist()) | set(mesh.regions.tolist()):
                 assert our_areas[mesh.regions == mk].sum() == pytest.approx(
-                    their_areas[attrs.astype(int) == mk].sum(), rel=1e-9, abs=1e-300)
+                    their_areas[attrs.astype(int) == mk].sum(), rel=1e-9, abs=1e-300
+                )
     else:
         assert (mesh.regions == 0).all()
     return mesh, unique
 
 
 def cross_check_case(case, **kw):
-    return cross_check(case["vertices"], case["segments"], case["holes"], case["regions"],
-                       area=case["area"], **kw)
+    return cross_check(
+        case["vertices"], case["segments"], case["holes"], case["regions"], area=case["area"], **kw
+    )
 
 
 # --------------------------------------------------------------------------------------
@@ -343,14 +370,16 @@ def test_nested_rings_match_triangle(seed):
 
 def test_large_polygon_with_holes_matches_triangle():
     rng = np.random.default_rng(7)
-    case = pc.polygon_with_holes(rng, n_outer=300, n_inner_rings=4, n_points=2000,
-                                 n_extra_segments=150)
+    case = pc.polygon_with_holes(
+        rng, n_outer=300, n_inner_rings=4, n_points=2000, n_extra_segments=150
+    )
     assert cross_check_case(case, check_cover=True)[1], "random PSLG in general position"
 
 
 # --------------------------------------------------------------------------------------
 # Triangle's own sample files
 # --------------------------------------------------------------------------------------
+
 
 def _sample_names():
     names = set()
@@ -383,12 +412,21 @@ def poly_region_points(name):
     if k >= len(lines) or int(lines[k][0]) == 0:
         return None
     n_regions = int(lines[k][0])
-    return np.array([(float(r[1]), float(r[2])) for r in lines[k + 1:k + 1 + n_regions]])
+    return np.array([(float(r[1]), float(r[2])) for r in lines[k + 1 : k + 1 + n_regions]])
 
 
 def test_sample_files_found():
-    assert {"A", "box", "double_hex", "face", "la", "square_circle_hole", "dots",
-            "spiral", "greenland"} <= set(SAMPLES)
+    assert {
+        "A",
+        "box",
+        "double_hex",
+        "face",
+        "la",
+        "square_circle_hole",
+        "dots",
+        "spiral",
+        "greenland",
+    } <= set(SAMPLES)
 
 
 @pytest.mark.parametrize("name", SAMPLES)
@@ -406,8 +444,14 @@ def test_triangle_sample_matches_triangle(name):
         mesh = aftmesh.cdt(V, S, holes=H)
         check_mesh(mesh)
         assert mesh.n_triangles == 0
-        assert len(triangle.triangulate(dict(vertices=V, segments=S, holes=H), "p")
-                   .get("triangles", [])) == 0
+        assert (
+            len(
+                triangle.triangulate(dict(vertices=V, segments=S, holes=H), "p").get(
+                    "triangles", []
+                )
+            )
+            == 0
+        )
         return
     cross_check(V, S, H, R)
 
@@ -415,6 +459,7 @@ def test_triangle_sample_matches_triangle(name):
 # --------------------------------------------------------------------------------------
 # 2. cocircular inputs: the CDT is not unique
 # --------------------------------------------------------------------------------------
+
 
 def lattice_circle(r2):
     """All integer points with x^2 + y^2 == r2 (exactly cocircular)."""
@@ -453,12 +498,19 @@ def test_grid_with_boundary_ring_and_square_hole(nx, ny):
         for i in range(nx):
             idx[j, i] = len(V)
             V.append((i, j))
-    ring = ([idx[0, i] for i in range(nx)] + [idx[j, nx - 1] for j in range(1, ny)]
-            + [idx[ny - 1, i] for i in range(nx - 2, -1, -1)]
-            + [idx[j, 0] for j in range(ny - 2, 0, -1)])
+    ring = (
+        [idx[0, i] for i in range(nx)]
+        + [idx[j, nx - 1] for j in range(1, ny)]
+        + [idx[ny - 1, i] for i in range(nx - 2, -1, -1)]
+        + [idx[j, 0] for j in range(ny - 2, 0, -1)]
+    )
     S = [(ring[k], ring[(k + 1) % len(ring)]) for k in range(len(ring))]
-    S += [(idx[1, 1], idx[1, 2]), (idx[1, 2], idx[2, 2]), (idx[2, 2], idx[2, 1]),
-          (idx[2, 1], idx[1, 1])]
+    S += [
+        (idx[1, 1], idx[1, 2]),
+        (idx[1, 2], idx[2, 2]),
+        (idx[2, 2], idx[2, 1]),
+        (idx[2, 1], idx[1, 1]),
+    ]
     mesh, unique = check_degenerate(V, S, [(1.5, 1.5)], area=(nx - 1) * (ny - 1) - 1)
     assert not unique
     assert mesh.n_triangles == 2 * ((nx - 1) * (ny - 1) - 1)
@@ -514,6 +566,7 @@ def test_rotated_lattice_and_triangular_lattice():
 # 3. small cases worked out by hand
 # --------------------------------------------------------------------------------------
 
+
 def test_square_with_centre(checked):
     mesh = checked(aftmesh.cdt([(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0.5)]), domain_area=1.0)
     assert mesh.n_points == 5 and mesh.n_triangles == 4
@@ -530,8 +583,11 @@ def test_square_with_centre(checked):
 def test_square_with_square_hole(checked):
     V = [(0, 0), (2, 0), (2, 2), (0, 2), (0.5, 0.5), (1.5, 0.5), (1.5, 1.5), (0.5, 1.5)]
     S = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)]
-    mesh = checked(aftmesh.cdt(V, S, holes=[(1, 1)]), domain_area=3.0,
-                   input_segments=np.asarray(V, float)[np.asarray(S)])
+    mesh = checked(
+        aftmesh.cdt(V, S, holes=[(1, 1)]),
+        domain_area=3.0,
+        input_segments=np.asarray(V, float)[np.asarray(S)],
+    )
     assert mesh.n_triangles == 8
     assert mesh.area() == 3.0
     centroids = mesh.points[mesh.triangles].mean(axis=1)
@@ -544,15 +600,23 @@ def test_square_with_square_hole(checked):
 
 
 def test_segment_through_collinear_vertices_is_split(checked):
-    V = [(0, 0), (2, 0), (2, 2), (0, 2),   # square ring
-         (1, 0),                           # on the bottom side
-         (1, 1)]                           # on the diagonal 0-2
+    V = [
+        (0, 0),
+        (2, 0),
+        (2, 2),
+        (0, 2),  # square ring
+        (1, 0),  # on the bottom side
+        (1, 1),
+    ]  # on the diagonal 0-2
     S = [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2)]
-    mesh = checked(aftmesh.cdt(V, S), domain_area=4.0,
-                   input_segments=np.asarray(V, float)[np.asarray(S)])
+    mesh = checked(
+        aftmesh.cdt(V, S), domain_area=4.0, input_segments=np.asarray(V, float)[np.asarray(S)]
+    )
     vm = mesh.info["vertex_map"]
-    got = {frozenset((int(u), int(v))): int(m)
-           for (u, v), m in zip(mesh.segments.tolist(), mesh.segment_markers.tolist())}
+    got = {
+        frozenset((int(u), int(v))): int(m)
+        for (u, v), m in zip(mesh.segments.tolist(), mesh.segment_markers.tolist())
+    }
     want = {(0, 4): 0, (4, 1): 0, (1, 2): 1, (2, 3): 2, (3, 0): 3, (0, 5): 4, (5, 2): 4}
     assert got == {frozenset((int(vm[a]), int(vm[b]))): m for (a, b), m in want.items()}
     # 5 boundary vertices, 1 interior: 5 - 2 + 2 = 5 triangles
@@ -563,11 +627,15 @@ def test_segment_through_several_collinear_vertices(checked):
     # a horizontal segment through 3 vertices, inside a triangle ring
     V = [(-1, -1), (5, -1), (2, 4), (0, 0), (4, 0), (1, 0), (3, 0), (2, 0)]
     S = [(0, 1), (1, 2), (2, 0), (3, 4)]
-    mesh = checked(aftmesh.cdt(V, S), domain_area=15.0,
-                   input_segments=np.asarray(V, float)[np.asarray(S)])
+    mesh = checked(
+        aftmesh.cdt(V, S), domain_area=15.0, input_segments=np.asarray(V, float)[np.asarray(S)]
+    )
     vm = mesh.info["vertex_map"]
-    pieces = {frozenset((int(u), int(v))) for (u, v), m in
-              zip(mesh.segments.tolist(), mesh.segment_markers.tolist()) if m == 3}
+    pieces = {
+        frozenset((int(u), int(v)))
+        for (u, v), m in zip(mesh.segments.tolist(), mesh.segment_markers.tolist())
+        if m == 3
+    }
     chain = [3, 5, 7, 6, 4]
     assert pieces == {frozenset((int(vm[a]), int(vm[b]))) for a, b in zip(chain, chain[1:])}
     assert len(mesh.segments) == 3 + 4
@@ -600,11 +668,21 @@ def test_duplicates_referenced_by_segments(checked):
 def test_regions_markers_land_on_the_right_triangles(checked):
     # three vertical strips of the rectangle [0,3]x[0,1]; the left gets 7, the right 9,
     # the middle no marker (0)
-    V = [(0, 0), (1, 0), (2, 0), (3, 0), (3, 1), (2, 1), (1, 1), (0, 1),
-         (0.5, 0.3), (1.5, 0.6), (2.5, 0.4)]
+    V = [
+        (0, 0),
+        (1, 0),
+        (2, 0),
+        (3, 0),
+        (3, 1),
+        (2, 1),
+        (1, 1),
+        (0, 1),
+        (0.5, 0.3),
+        (1.5, 0.6),
+        (2.5, 0.4),
+    ]
     S = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 0), (1, 6), (2, 5)]
-    mesh = checked(aftmesh.cdt(V, S, regions=[(0.2, 0.9, 7), (2.9, 0.1, 9)]),
-                   domain_area=3.0)
+    mesh = checked(aftmesh.cdt(V, S, regions=[(0.2, 0.9, 7), (2.9, 0.1, 9)]), domain_area=3.0)
     cx = mesh.points[mesh.triangles].mean(axis=1)[:, 0]
     want = np.where(cx < 1, 7, np.where(cx > 2, 9, 0))
     assert np.array_equal(mesh.regions, want)
@@ -623,12 +701,15 @@ def test_region_markers_inside_and_around_an_inner_ring(checked):
     assert inner.sum() == 2
 
 
-@pytest.mark.parametrize("regions,want", [
-    ([(0.1, 0.1, 3), (1.9, 1.9, 4)], {4}),          # same region twice: the last wins
-                                                     # (as in Triangle)
-    ([(1.2, 1.2, 5)], {0}),                          # only inside the hole: ignored
-    ([(0.1, 0.1, -2)], {-2}),                        # negative markers are markers
-])
+@pytest.mark.parametrize(
+    "regions,want",
+    [
+        ([(0.1, 0.1, 3), (1.9, 1.9, 4)], {4}),  # same region twice: the last wins
+        # (as in Triangle)
+        ([(1.2, 1.2, 5)], {0}),  # only inside the hole: ignored
+        ([(0.1, 0.1, -2)], {-2}),  # negative markers are markers
+    ],
+)
 def test_regions_and_holes_together_as_triangle_does(regions, want, checked):
     V = [(0, 0), (2, 0), (2, 2), (0, 2), (0.5, 0.5), (1.5, 0.5), (1.5, 1.5), (0.5, 1.5)]
     S = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)]
@@ -642,8 +723,9 @@ def test_random_duplicates_are_merged(seed):
     """A random PSLG with copies of some of its vertices appended, and segments
     referring to the copies at random: the same CDT as without the copies."""
     rng = np.random.default_rng(500 + seed)
-    case = pc.polygon_with_holes(rng, n_points=int(rng.integers(0, 100)),
-                                 n_extra_segments=int(rng.integers(0, 10)))
+    case = pc.polygon_with_holes(
+        rng, n_points=int(rng.integers(0, 100)), n_extra_segments=int(rng.integers(0, 10))
+    )
     V, S = case["vertices"], case["segments"].copy()
     n = len(V)
     originals = rng.choice(n, size=max(1, n // 8), replace=False)
@@ -670,7 +752,7 @@ def test_no_segments_keeps_the_convex_hull(checked):
     # an L-shaped point set: the hull covers the notch
     V = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
     mesh = checked(aftmesh.cdt(V), domain_area=3.5)
-    assert mesh.n_triangles == 5   # 6 points, 5 on the hull: 2*6 - 2 - 5
+    assert mesh.n_triangles == 5  # 6 points, 5 on the hull: 2*6 - 2 - 5
     assert len(mesh.segments) == 0
 
 
@@ -693,8 +775,9 @@ SQUARE = [(0, 0), (1, 0), (1, 1), (0, 1)]
 RING = [(0, 1), (1, 2), (2, 3), (3, 0)]
 
 
-@pytest.mark.parametrize("bad,index", [((np.nan, 0.5), 2), ((0.5, np.inf), 4),
-                                       ((-np.inf, 0), 0), ((1e300, 0), 1)])
+@pytest.mark.parametrize(
+    "bad,index", [((np.nan, 0.5), 2), ((0.5, np.inf), 4), ((-np.inf, 0), 0), ((1e300, 0), 1)]
+)
 def test_non_finite_or_huge_coordinates(bad, index):
     V = np.array(SQUARE + [(0.5, 0.5)], dtype=float)
     V[index] = bad
@@ -702,28 +785,34 @@ def test_non_finite_or_huge_coordinates(bad, index):
         aftmesh.cdt(V)
 
 
-@pytest.mark.parametrize("V", [
-    [(0, 0, 0), (1, 0, 0), (0, 1, 0)],
-    [0, 1, 2, 3, 4, 5],
-    [[(0, 0)], [(1, 0)], [(0, 1)]],
-    [(0, 0), (1, 0), (0, 1, 2)],
-    [("a", "b"), (1, 0), (0, 1)],
-    "abc",
-])
+@pytest.mark.parametrize(
+    "V",
+    [
+        [(0, 0, 0), (1, 0, 0), (0, 1, 0)],
+        [0, 1, 2, 3, 4, 5],
+        [[(0, 0)], [(1, 0)], [(0, 1)]],
+        [(0, 0), (1, 0), (0, 1, 2)],
+        [("a", "b"), (1, 0), (0, 1)],
+        "abc",
+    ],
+)
 def test_malformed_vertices(V):
     with pytest.raises(InvalidInputError, match="vertices"):
         aftmesh.cdt(V)
 
 
-@pytest.mark.parametrize("S,pattern", [
-    ([(0, 1, 2)], r"shape"),
-    ([0, 1, 2, 3], r"shape"),
-    ([(0, 4)], r"segments\[0\].*4"),
-    ([(0, 1), (1, 2), (2, -1)], r"segments\[2\].*-1"),
-    ([(0, 1), (2, 2)], r"segments\[1\]"),
-    ([(0.5, 1), (1, 2)], r"integer"),
-    ([(0, 1), (1, 2), (2, 10**12)], r"segments\[2\]"),
-])
+@pytest.mark.parametrize(
+    "S,pattern",
+    [
+        ([(0, 1, 2)], r"shape"),
+        ([0, 1, 2, 3], r"shape"),
+        ([(0, 4)], r"segments\[0\].*4"),
+        ([(0, 1), (1, 2), (2, -1)], r"segments\[2\].*-1"),
+        ([(0, 1), (2, 2)], r"segments\[1\]"),
+        ([(0.5, 1), (1, 2)], r"integer"),
+        ([(0, 1), (1, 2), (2, 10**12)], r"segments\[2\]"),
+    ],
+)
 def test_malformed_segments(S, pattern):
     with pytest.raises(InvalidInputError, match=pattern):
         aftmesh.cdt(SQUARE, S)
@@ -780,8 +869,9 @@ def test_overlapping_collinear_segments_are_split_not_crossing(checked):
     # other, so both are split there and the pieces (1-2, 2-3, 3-3.5) are the segments
     V = [(0, 0), (4, 0), (4, 2), (0, 2), (1, 1), (3, 1), (2, 1), (3.5, 1)]
     S = RING + [(4, 5), (6, 7)]
-    mesh = checked(aftmesh.cdt(V, S), domain_area=8.0,
-                   input_segments=np.asarray(V, float)[np.asarray(S)])
+    mesh = checked(
+        aftmesh.cdt(V, S), domain_area=8.0, input_segments=np.asarray(V, float)[np.asarray(S)]
+    )
     vm = mesh.info["vertex_map"]
     segs = {frozenset(map(int, s)) for s in mesh.segments.tolist()}
     want = {frozenset((int(vm[a]), int(vm[b]))) for a, b in RING + [(4, 6), (6, 5), (5, 7)]}
@@ -794,8 +884,9 @@ def test_t_junction_splits_the_touched_segment(checked):
     # segment 4 ends on the interior of segment 5 at an input vertex: no crossing
     V = [(0, 0), (4, 0), (4, 4), (0, 4), (2, 1), (2, 3), (1, 3), (3, 3)]
     S = RING + [(4, 5), (6, 7)]
-    mesh = checked(aftmesh.cdt(V, S), domain_area=16.0,
-                   input_segments=np.asarray(V, float)[np.asarray(S)])
+    mesh = checked(
+        aftmesh.cdt(V, S), domain_area=16.0, input_segments=np.asarray(V, float)[np.asarray(S)]
+    )
     assert len(mesh.segments) == 4 + 1 + 2
     cross_check(V, S)
 
@@ -819,14 +910,19 @@ def test_the_oracle_helpers_can_fail():
     different triangle set is caught by cross_check's set comparison."""
     V = np.array([(0, 0), (2, 0), (2.1, 1), (0, 1.2)])
     good = run_triangle(V, np.zeros((0, 2)), np.zeros((0, 2)), np.zeros((0, 3)))["triangles"]
-    diag = [frozenset(e) for t in np.asarray(good).tolist()
-            for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))]
+    diag = [
+        frozenset(e)
+        for t in np.asarray(good).tolist()
+        for e in ((t[0], t[1]), (t[1], t[2]), (t[2], t[0]))
+    ]
     inner = [e for e in set(diag) if diag.count(e) == 2][0]
     a, b = sorted(inner)
     c, d = sorted(set(range(4)) - {a, b})
     flipped = [(a, c, d), (b, c, d)]
-    flipped = [t if exact_orient(exact_ints(V), [t[0]], [t[1]], [t[2]])[0] > 0 else t[::-1]
-               for t in flipped]
+    flipped = [
+        t if exact_orient(exact_ints(V), [t[0]], [t[1]], [t[2]])[0] > 0 else t[::-1]
+        for t in flipped
+    ]
     assert exact_report(V, good, [])["non_delaunay"] == 0
     rep = exact_report(V, flipped, [])
     assert rep["non_delaunay"] == 1 and rep["not_ccw"] == 0
@@ -837,12 +933,15 @@ def test_the_oracle_helpers_can_fail():
     assert exact_incircle(Q, [0, 0, 0], [1, 1, 1], [2, 2, 2], [3, 4, 5]).tolist() == [1, 0, -1]
 
 
-@pytest.mark.parametrize("V", [
-    [(0, 0), (1, 1), (2, 2)],
-    [(0, 0), (1, 1), (2, 2), (3, 3), (-5, -5)],
-    [(0, 1), (0, 2), (0, 3), (0, 1)],
-    [(0.1 * i, 0.3) for i in range(20)],
-])
+@pytest.mark.parametrize(
+    "V",
+    [
+        [(0, 0), (1, 1), (2, 2)],
+        [(0, 0), (1, 1), (2, 2), (3, 3), (-5, -5)],
+        [(0, 1), (0, 2), (0, 3), (0, 1)],
+        [(0.1 * i, 0.3) for i in range(20)],
+    ],
+)
 def test_all_collinear_points(V):
     with pytest.raises(InvalidDomainError, match="collinear"):
         aftmesh.cdt(V)
@@ -859,8 +958,10 @@ def test_three_points_two_of_them_equal():
         aftmesh.cdt([(0, 0), (1, 1), (0, 0)])
 
 
-@pytest.mark.parametrize("holes,index", [([(5, 5)], 0), ([(0.5, 0.5), (-1, 0.5)], 1),
-                                         ([(0.5, 0.5), (0.5, 0.5), (2, 2)], 2)])
+@pytest.mark.parametrize(
+    "holes,index",
+    [([(5, 5)], 0), ([(0.5, 0.5), (-1, 0.5)], 1), ([(0.5, 0.5), (0.5, 0.5), (2, 2)], 2)],
+)
 def test_hole_point_outside_the_domain(holes, index):
     V = SQUARE + [(0.25, 0.25), (0.75, 0.25), (0.5, 0.75)]
     S = RING + [(4, 5), (5, 6), (6, 4)]
@@ -898,18 +999,23 @@ def test_malformed_regions(regions):
 # asked about "clean" ones: it crashes or hangs on some of these degenerate inputs
 # (duplicate vertices in segments, overlapping segments).
 
+
 def _orient_exact(a, b, c):
     return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 
 
 def _fractions(V):
     from fractions import Fraction
+
     return [(Fraction(float(x)), Fraction(float(y))) for x, y in V]
 
 
 def _on_closed_segment(a, b, p):
-    return (_orient_exact(a, b, p) == 0 and min(a[0], b[0]) <= p[0] <= max(a[0], b[0])
-            and min(a[1], b[1]) <= p[1] <= max(a[1], b[1]))
+    return (
+        _orient_exact(a, b, p) == 0
+        and min(a[0], b[0]) <= p[0] <= max(a[0], b[0])
+        and min(a[1], b[1]) <= p[1] <= max(a[1], b[1])
+    )
 
 
 def crossing_pairs(V, S):
@@ -956,14 +1062,21 @@ def is_clean(V, S):
         return False
     if len({frozenset(s) for s in S}) != len(S) or any(a == b for a, b in S):
         return False
-    return not any(_on_closed_segment(X[a], X[b], p)
-                   for a, b in S for k, p in enumerate(X) if k not in (a, b))
+    return not any(
+        _on_closed_segment(X[a], X[b], p) for a, b in S for k, p in enumerate(X) if k not in (a, b)
+    )
 
 
 # coordinate frames for the fuzzers: base + i * step for small integers i; the inexact
 # steps make nearly collinear / nearly cocircular points and near-misses of vertices
-FRAMES = [(0.0, 1.0), (0.0, 0.1), (0.0, 1 / 3), (0.5, 2.0 ** -45), (1e7, float(np.spacing(1e7))),
-          (-3e-7, 1e-7)]
+FRAMES = [
+    (0.0, 1.0),
+    (0.0, 0.1),
+    (0.0, 1 / 3),
+    (0.5, 2.0**-45),
+    (1e7, float(np.spacing(1e7))),
+    (-3e-7, 1e-7),
+]
 
 
 @st.composite
@@ -971,21 +1084,30 @@ def small_pslgs(draw):
     base, step = draw(st.sampled_from(FRAMES))
     n = draw(st.integers(0, 10))
     coord = st.integers(-3, 3)
-    V = [(base + i * step, base + j * step)
-         for i, j in draw(st.lists(st.tuples(coord, coord), min_size=n, max_size=n))]
+    V = [
+        (base + i * step, base + j * step)
+        for i, j in draw(st.lists(st.tuples(coord, coord), min_size=n, max_size=n))
+    ]
     idx = st.integers(-1, n) if draw(st.booleans()) else st.integers(0, max(n - 1, 0))
     S = draw(st.lists(st.tuples(idx, idx), max_size=8))
     # hole points at irrational-ish offsets, dropped if rounding puts them on a vertex
     # or a segment (where Triangle picks a side arbitrarily; see the regression test
     # for a hole point on a vertex)
     off = (np.sqrt(2) - 1, 1 / np.pi)
-    H = [(base + (i + off[0]) * step, base + (j + off[1]) * step)
-         for i, j in draw(st.lists(st.tuples(coord, coord), max_size=2))]
+    H = [
+        (base + (i + off[0]) * step, base + (j + off[1]) * step)
+        for i, j in draw(st.lists(st.tuples(coord, coord), max_size=2))
+    ]
     X = _fractions(V)
-    H = [h for h in H
-         if not any(_on_closed_segment(X[a], X[b], _fractions([h])[0])
-                    for a, b in S + [(k, k) for k in range(n)]
-                    if 0 <= a < n and 0 <= b < n)]
+    H = [
+        h
+        for h in H
+        if not any(
+            _on_closed_segment(X[a], X[b], _fractions([h])[0])
+            for a, b in S + [(k, k) for k in range(n)]
+            if 0 <= a < n and 0 <= b < n
+        )
+    ]
     return V, S, H
 
 
@@ -1025,8 +1147,7 @@ def small_segment_graphs(draw):
     ij = draw(st.lists(st.tuples(coord, coord), min_size=3, max_size=10, unique=True))
     V = [(base + i * step, base + j * step) for i, j in ij]
     idx = st.integers(0, len(V) - 1)
-    S = draw(st.lists(st.tuples(idx, idx).filter(lambda s: s[0] != s[1]),
-                      min_size=1, max_size=10))
+    S = draw(st.lists(st.tuples(idx, idx).filter(lambda s: s[0] != s[1]), min_size=1, max_size=10))
     return V, S
 
 
@@ -1072,6 +1193,7 @@ def test_fuzz_crossings_splits_and_overlaps(graph):
 # 5. near-degenerate inputs
 # --------------------------------------------------------------------------------------
 
+
 def _count_check(V, S=None, H=None):
     """check_mesh, the exact CDT property, and Triangle's count (set equality when
     Triangle's CDT is unique)."""
@@ -1080,7 +1202,7 @@ def _count_check(V, S=None, H=None):
 
 @pytest.mark.parametrize("exp", [45, 50, 52, 53])
 def test_tiny_lattice_around_half(exp):
-    h = 2.0 ** -exp
+    h = 2.0**-exp
     i, j = np.meshgrid(np.arange(-4, 5), np.arange(-4, 5))
     V = 0.5 + h * np.c_[i.ravel(), j.ravel()]
     V = np.unique(V, axis=0)
@@ -1092,19 +1214,20 @@ def test_tiny_lattice_around_half(exp):
 def test_random_points_on_a_tiny_lattice(seed):
     rng = np.random.default_rng(seed)
     k = rng.integers(-300, 301, size=(300, 2))
-    V = np.unique(0.5 + k * 2.0 ** -53, axis=0)
+    V = np.unique(0.5 + k * 2.0**-53, axis=0)
     _count_check(V)
 
 
 @pytest.mark.parametrize("seed", range(6))
 def test_tiny_lattice_with_segments(seed):
     rng = np.random.default_rng(40 + seed)
-    h = 2.0 ** -45
+    h = 2.0**-45
     k = rng.integers(-200, 201, size=(200, 2)).astype(float)
     corners = np.array([(-250, -250), (250, -250), (250, 250), (-250, 250)], float)
     pts = np.vstack([corners, np.unique(k, axis=0)])
-    S = pc.add_noncrossing_segments(rng, pts, 60, existing=RING, margin=1e-12,
-                                    allowed=lambda i, j: i >= 4 and j >= 4)
+    S = pc.add_noncrossing_segments(
+        rng, pts, 60, existing=RING, margin=1e-12, allowed=lambda i, j: i >= 4 and j >= 4
+    )
     V = 0.5 + h * pts
     _count_check(V, S)
 
@@ -1116,7 +1239,7 @@ def test_nearly_collinear_points(seed):
     x = np.sort(rng.random(200))
     line = np.c_[x, x / 3]
     # a second family: one ulp above or below an exact line y = 0.5 (exactly collinear)
-    y = 0.5 + rng.integers(-2, 3, size=100) * 2.0 ** -53
+    y = 0.5 + rng.integers(-2, 3, size=100) * 2.0**-53
     flat = np.c_[rng.random(100), y]
     far = np.array([(0.5, 10.0), (0.5, -10.0), (-3.0, 0.2)])
     V = np.unique(np.vstack([line, flat, far]), axis=0)
@@ -1127,7 +1250,7 @@ def test_nearly_collinear_segment_chain():
     # a long chain of segments along a nearly straight line, inside a box ring
     n = 300
     x = np.linspace(0.01, 0.99, n)
-    y = 0.5 + (np.arange(n) % 3 - 1) * 2.0 ** -52
+    y = 0.5 + (np.arange(n) % 3 - 1) * 2.0**-52
     V = np.vstack([SQUARE, np.c_[x, y]]).astype(float)
     S = RING + [(4 + k, 5 + k) for k in range(n - 1)]
     _count_check(V, S)
@@ -1136,7 +1259,7 @@ def test_nearly_collinear_segment_chain():
 @pytest.mark.parametrize("seed", range(5))
 def test_large_coordinates_with_tiny_detail(seed):
     rng = np.random.default_rng(200 + seed)
-    ulp = np.spacing(1e7)           # ~1.9e-9
+    ulp = np.spacing(1e7)  # ~1.9e-9
     k = rng.integers(-500, 501, size=(400, 2))
     V = np.unique(1e7 + k * ulp, axis=0)
     _count_check(V)
@@ -1151,8 +1274,12 @@ def test_scaled_by_1e_minus_6(seed):
     rng = np.random.default_rng(300 + seed)
     case = pc.polygon_with_holes(rng, n_extra_segments=10)
     for s in (1e-6, 1e-12, 1e6):
-        cross_check(case["vertices"] * s, case["segments"], case["holes"] * s,
-                    np.c_[case["regions"][:, :2] * s, case["regions"][:, 2]])
+        cross_check(
+            case["vertices"] * s,
+            case["segments"],
+            case["holes"] * s,
+            np.c_[case["regions"][:, :2] * s, case["regions"][:, 2]],
+        )
 
 
 def test_kernel_predicates_match_rational_arithmetic():
@@ -1163,12 +1290,17 @@ def test_kernel_predicates_match_rational_arithmetic():
     for _ in range(300):
         a, b = rng.random(2), rng.random(2)
         t = rng.random()
-        c = a + t * (b - a) + rng.integers(-2, 3, size=2) * 2.0 ** -54
+        c = a + t * (b - a) + rng.integers(-2, 3, size=2) * 2.0**-54
         cases.append((a, b, c))
     # the triple from Triangle's spiral.q.1 sample that a floating-point orientation
     # gets wrong (exact value +5.2e-19)
-    cases.append((np.array([0.004999999999999942, 1.963]), np.array([-1.35, 0.436]),
-                  np.array([-0.6725000000000001, 1.1995])))
+    cases.append(
+        (
+            np.array([0.004999999999999942, 1.963]),
+            np.array([-1.35, 0.436]),
+            np.array([-0.6725000000000001, 1.1995]),
+        )
+    )
     P = np.asarray([p for c in cases for p in c])
     Q = exact_ints(P)
     idx = np.arange(len(P)).reshape(-1, 3)
@@ -1199,6 +1331,7 @@ def test_kernel_predicates_match_rational_arithmetic():
 # --------------------------------------------------------------------------------------
 # regressions found while writing these tests
 # --------------------------------------------------------------------------------------
+
 
 def test_bare_points_give_the_hull_without_segments(checked):
     """Without input segments the domain is the convex hull and there are no segments
@@ -1241,10 +1374,15 @@ def test_regression_segment_marker_of_a_segment_leaving_the_domain():
         S = [(new[a], new[b]) for a, b in S0]
         mesh = aftmesh.cdt(V, S)
         check_mesh(mesh)
-        got = {frozenset(map(tuple, mesh.points[[u, v]].tolist())): int(k)
-               for (u, v), k in zip(mesh.segments, mesh.segment_markers)}
-        want = {frozenset((tuple(map(float, V[a])), tuple(map(float, V[b])))): k
-                for k, (a, b) in enumerate(S) if k != 2}
+        got = {
+            frozenset(map(tuple, mesh.points[[u, v]].tolist())): int(k)
+            for (u, v), k in zip(mesh.segments, mesh.segment_markers)
+        }
+        want = {
+            frozenset((tuple(map(float, V[a])), tuple(map(float, V[b])))): k
+            for k, (a, b) in enumerate(S)
+            if k != 2
+        }
         if got != want:
             wrong.append(perm)
     assert not wrong, f"{len(wrong)} of 120 numberings give wrong markers, e.g. {wrong[0]}"
@@ -1255,8 +1393,7 @@ def test_regression_hole_point_on_a_vertex_removes_nothing():
     carves nothing: the square hole below keeps its 4 triangles (12 in all, area 4).
     Triangle eats the hole (8 triangles, area 3); rejecting the hole point would be a
     fair policy too, silently ignoring it is not."""
-    V = [(0, 0), (2, 0), (2, 2), (0, 2), (0.5, 0.5), (1.5, 0.5), (1.5, 1.5), (0.5, 1.5),
-         (1, 1)]
+    V = [(0, 0), (2, 0), (2, 2), (0, 2), (0.5, 0.5), (1.5, 0.5), (1.5, 1.5), (0.5, 1.5), (1, 1)]
     S = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)]
     try:
         mesh = aftmesh.cdt(V, S, holes=[(1, 1)])

@@ -5,6 +5,7 @@ decided exactly (orient2d == 0 and within the input segment's span), through spl
 at vertices lying on segments and at crossing points.  Crossing splits: the result
 must be Triangle's ``p`` triangulation of the same input.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -19,14 +20,12 @@ from aftmesh.errors import CrossingSegmentsError, InvalidOptionError
 
 def _within_span(p, a, b):
     """p (collinear with a-b) lies on the closed segment a-b: exact coordinate tests."""
-    return (min(a[0], b[0]) <= p[0] <= max(a[0], b[0])
-            and min(a[1], b[1]) <= p[1] <= max(a[1], b[1]))
+    return min(a[0], b[0]) <= p[0] <= max(a[0], b[0]) and min(a[1], b[1]) <= p[1] <= max(a[1], b[1])
 
 
 def _contains(V, S, j, p):
     a, b = V[S[j, 0]], V[S[j, 1]]
-    return (_kernel.py_orient2d(a[0], a[1], b[0], b[1], p[0], p[1]) == 0
-            and _within_span(p, a, b))
+    return _kernel.py_orient2d(a[0], a[1], b[0], b[1], p[0], p[1]) == 0 and _within_span(p, a, b)
 
 
 def assert_pieces_on_their_segments(mesh, V, S):
@@ -36,8 +35,9 @@ def assert_pieces_on_their_segments(mesh, V, S):
     P = mesh.points
     assert len(mesh.segment_markers) == len(mesh.segments)
     for (u, v), j in zip(mesh.segments.tolist(), mesh.segment_markers.tolist()):
-        holders = [k for k in range(len(S)) if _contains(V, S, k, P[u])
-                   and _contains(V, S, k, P[v])]
+        holders = [
+            k for k in range(len(S)) if _contains(V, S, k, P[u]) and _contains(V, S, k, P[v])
+        ]
         assert holders, f"segment ({u}, {v}) lies on no input segment"
         assert j == min(holders), f"segment ({u}, {v}) is marked {j}, lies on {holders}"
 
@@ -77,8 +77,11 @@ def test_segment_ids_name_the_input_segment_each_piece_lies_on(seed, checked):
     # and every input segment is covered by the pieces lying on it, end to end
     P = mesh.points
     for j in range(len(S)):
-        on = [k for k, (u, v) in enumerate(mesh.segments.tolist())
-              if _contains(V, S, j, P[u]) and _contains(V, S, j, P[v])]
+        on = [
+            k
+            for k, (u, v) in enumerate(mesh.segments.tolist())
+            if _contains(V, S, j, P[u]) and _contains(V, S, j, P[v])
+        ]
         pieces = mesh.segments[on]
         length = np.abs(P[pieces[:, 1]] - P[pieces[:, 0]]).max(axis=1)
         assert length.sum() == np.abs(V[S[j, 1]] - V[S[j, 0]]).max(), j
@@ -89,11 +92,9 @@ def test_segment_ids_through_vertices_on_the_segment_in_the_kernel():
     V = np.array([(0, 0), (4, 0), (4, 4), (0, 4), (1, 0), (3, 0)], dtype=np.float64)
     k = _kernel.Triangulation(V)
     k.insert_points(np.arange(len(V), dtype=np.int32))
-    assert k.insert_segments(np.array([(0, 1), (0, 2), (1, 2)], dtype=np.int32),
-                             first_id=7) == 1
+    assert k.insert_segments(np.array([(0, 1), (0, 2), (1, 2)], dtype=np.int32), first_id=7) == 1
     a = k.arrays()
-    ids = {tuple(sorted(s)): i for s, i in zip(a["segments"].tolist(),
-                                               a["segment_ids"].tolist())}
+    ids = {tuple(sorted(s)): i for s, i in zip(a["segments"].tolist(), a["segment_ids"].tolist())}
     vm = a["vertex_map"]
     assert ids[tuple(sorted((vm[0], vm[4])))] == 7
     assert ids[tuple(sorted((vm[4], vm[5])))] == 7
@@ -118,6 +119,7 @@ def test_crossings_option_is_checked():
 
 def test_split_without_crossings_is_the_plain_cdt(rng):
     import pslg_cases as pc
+
     case = pc.box_with_segments(rng, 40, 20)
     plain = aftmesh.cdt(case["vertices"], case["segments"])
     split = aftmesh.cdt(case["vertices"], case["segments"], crossings="split")
@@ -130,15 +132,19 @@ def random_crossing_case(rng, n_segments):
     """The unit square's ring holding random segments that cross each other."""
     inner = 0.05 + 0.9 * rng.random((2 * n_segments, 2))
     V = np.vstack([[(0, 0), (1, 0), (1, 1), (0, 1)], inner])
-    S = np.vstack([[(0, 1), (1, 2), (2, 3), (3, 0)],
-                   4 + np.arange(2 * n_segments).reshape(-1, 2)])
+    S = np.vstack([[(0, 1), (1, 2), (2, 3), (3, 0)], 4 + np.arange(2 * n_segments).reshape(-1, 2)])
     return V, S
 
 
 def _triangle_p(V, S):
     out = triangle.triangulate(
-        {"vertices": V, "segments": S.astype(np.int32),
-             "segment_markers": (np.arange(len(S)) + 1).astype(np.int32).reshape(-1, 1)}, "p")
+        {
+            "vertices": V,
+            "segments": S.astype(np.int32),
+            "segment_markers": (np.arange(len(S)) + 1).astype(np.int32).reshape(-1, 1),
+        },
+        "p",
+    )
     return out
 
 
@@ -146,6 +152,7 @@ def _pair_vertices(ours, theirs, ulps=4):
     """For each of our points, the index of Triangle's point at the same place: the
     same coordinates, or else the nearest within `ulps` units in the last place."""
     from scipy.spatial import cKDTree
+
     tol = ulps * np.spacing(np.abs(theirs).max())
     dist, idx = cKDTree(theirs).query(ours)
     exact = (theirs[idx] == ours).all(axis=1)
@@ -183,10 +190,16 @@ def test_split_crossings_matches_triangle(seed, checked):
         assert ours == theirs, f"triangles differ: {sorted(ours ^ theirs)[:6]}"
     else:
         assert len(ours) == len(theirs)
-    our_marks = {frozenset(s): m for s, m in zip(pair[mesh.segments].tolist(),
-                                                 mesh.segment_markers.tolist())}
-    their_marks = {frozenset(s): m - 1 for s, m in zip(
-        np.asarray(ref["segments"]).tolist(), np.asarray(ref["segment_markers"]).ravel().tolist())}
+    our_marks = {
+        frozenset(s): m for s, m in zip(pair[mesh.segments].tolist(), mesh.segment_markers.tolist())
+    }
+    their_marks = {
+        frozenset(s): m - 1
+        for s, m in zip(
+            np.asarray(ref["segments"]).tolist(),
+            np.asarray(ref["segment_markers"]).ravel().tolist(),
+        )
+    }
     assert our_marks == their_marks, "segment pieces or their markers differ from Triangle's"
     # every piece's marker is one of the input segments through both of its ends
     # (pieces of crossing-split segments are within an ulp of the segment, so this is

@@ -1,4 +1,5 @@
 """The ``aftmesh`` command (run in-process through ``main``) and the example domains."""
+
 import os
 import subprocess
 import sys
@@ -16,8 +17,7 @@ from aftmesh.io import read_poly
 
 triangle = pytest.importorskip("triangle")
 TRIANGLE_DATA = Path(triangle.__file__).parent / "data"
-SQUARE_WITH_HOLE = ("POLYGON ((0 0, 4 0, 4 2, 0 2, 0 0), "
-                    "(1 0.5, 1.5 0.5, 1.5 1.5, 1 1.5, 1 0.5))")
+SQUARE_WITH_HOLE = "POLYGON ((0 0, 4 0, 4 2, 0 2, 0 0), (1 0.5, 1.5 0.5, 1.5 1.5, 1 1.5, 1 0.5))"
 
 
 @pytest.fixture
@@ -53,15 +53,21 @@ def _error_line(capsys) -> str:
 
 # ------------------------------------------------------------------ demo
 
+
 def test_demo_quick_writes_files_and_prints_the_summary(tmp_path, capsys, checked_generate):
     pytest.importorskip("meshio")
     pytest.importorskip("matplotlib")
     import meshio
+
     assert main(["demo", "--quick", "--out", str(tmp_path / "out")]) == 0
     out = capsys.readouterr().out
     names = sorted(p.name for p in (tmp_path / "out").iterdir())
-    assert names == ["demo_airfoil.png", "demo_airfoil.vtu",
-                     "demo_inclusion.png", "demo_inclusion.vtu"]
+    assert names == [
+        "demo_airfoil.png",
+        "demo_airfoil.vtu",
+        "demo_inclusion.png",
+        "demo_inclusion.vtu",
+    ]
     assert len(checked_generate) == 2
     airfoil, inclusion = checked_generate
     assert set(np.unique(inclusion.regions).tolist()) == {0, 1}
@@ -69,8 +75,10 @@ def test_demo_quick_writes_files_and_prints_the_summary(tmp_path, capsys, checke
         q = mesh.quality()
         assert f"{mesh.n_triangles} triangles, {mesh.n_points} points" in out
         assert f"min {q['min_angle']:.2f} deg, max {q['max_angle']:.2f} deg" in out
-        assert (f"mean {q['radius_ratio_mean']:.4f}, min {q['radius_ratio_min']:.4f}, "
-                f"{100 * q['fraction_rr_above_0.9']:.1f} % above 0.9") in out
+        assert (
+            f"mean {q['radius_ratio_mean']:.4f}, min {q['radius_ratio_min']:.4f}, "
+            f"{100 * q['fraction_rr_above_0.9']:.1f} % above 0.9"
+        ) in out
         assert f"{mesh.info['timing']['total']:.3f} s (boundary" in out
         back = meshio.read(tmp_path / "out" / f"{stem}.vtu")
         np.testing.assert_array_equal(back.cells[0].data, mesh.triangles)
@@ -82,27 +90,41 @@ def test_demo_quick_writes_files_and_prints_the_summary(tmp_path, capsys, checke
 def test_demo_without_meshio_and_matplotlib(tmp_path, capsys, monkeypatch, checked_generate):
     monkeypatch.setitem(sys.modules, "meshio", None)
     monkeypatch.setitem(sys.modules, "matplotlib", None)
-    monkeypatch.chdir(tmp_path)                 # the default output directory
+    monkeypatch.chdir(tmp_path)  # the default output directory
     assert main(["demo", "--quick"]) == 0
     out = capsys.readouterr().out
     assert "meshio is not installed" in out and "matplotlib is not installed" in out
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        f"demo_{n}.{e}" for n in ("airfoil", "inclusion") for e in ("poly", "node", "ele"))
+        f"demo_{n}.{e}" for n in ("airfoil", "inclusion") for e in ("poly", "node", "ele")
+    )
     airfoil = checked_generate[0]
     d = read_poly(tmp_path / "demo_airfoil.poly")
     np.testing.assert_array_equal(d["vertices"], airfoil.points)
-    assert len(d["holes"]) == 1                # the airfoil
+    assert len(d["holes"]) == 1  # the airfoil
 
 
 # ------------------------------------------------------------------ mesh
+
 
 def test_mesh_a_poly_file(tmp_path, capsys, checked_generate):
     pytest.importorskip("meshio")
     pytest.importorskip("matplotlib")
     poly = TRIANGLE_DATA / "double_hex.poly"
-    status = main(["mesh", str(poly), "--size", "0.05", "--stats", "--out",
-                   str(tmp_path / "m.vtu"), "--png", str(tmp_path / "m.png"),
-                   "--color-by", "region"])
+    status = main(
+        [
+            "mesh",
+            str(poly),
+            "--size",
+            "0.05",
+            "--stats",
+            "--out",
+            str(tmp_path / "m.vtu"),
+            "--png",
+            str(tmp_path / "m.png"),
+            "--color-by",
+            "region",
+        ]
+    )
     assert status == 0
     (mesh,) = checked_generate
     out = capsys.readouterr().out
@@ -117,18 +139,30 @@ def test_mesh_a_poly_file(tmp_path, capsys, checked_generate):
         v = mesh.points[mesh.triangles] - (x, y)
         w = np.roll(v, -1, axis=1)
         cross = v[:, :, 0] * w[:, :, 1] - v[:, :, 1] * w[:, :, 0]
-        assert not (cross >= 0).all(axis=1).any()     # in no (counter-clockwise) triangle
+        assert not (cross >= 0).all(axis=1).any()  # in no (counter-clockwise) triangle
 
 
 def test_mesh_a_wkt_file_options(tmp_path, capsys, checked_generate):
     wkt = tmp_path / "sq.wkt"
     wkt.write_text(SQUARE_WITH_HOLE)
-    status = main(["mesh", str(wkt), "--size", "0.2", "--order", "oldest",
-                   "--max-triangles", "5000", "--out", str(tmp_path / "sq.ele")])
+    status = main(
+        [
+            "mesh",
+            str(wkt),
+            "--size",
+            "0.2",
+            "--order",
+            "oldest",
+            "--max-triangles",
+            "5000",
+            "--out",
+            str(tmp_path / "sq.ele"),
+        ]
+    )
     assert status == 0
     (mesh,) = checked_generate
     out = capsys.readouterr().out
-    assert "radius ratio" not in out            # no --stats: one line per action
+    assert "radius ratio" not in out  # no --stats: one line per action
     assert out.splitlines()[-1] == f"wrote {tmp_path / 'sq.ele'}"
     ref = triangle.load(str(tmp_path), "sq")
     np.testing.assert_array_equal(ref["triangles"], mesh.triangles)
@@ -137,8 +171,10 @@ def test_mesh_a_wkt_file_options(tmp_path, capsys, checked_generate):
 
 def test_mesh_a_geojson_file(tmp_path, capsys, checked_generate):
     p = tmp_path / "d.geojson"
-    p.write_text('{"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", '
-                 '"coordinates": [[[0, 0], [3, 0], [0, 2], [0, 0]]]}}')
+    p.write_text(
+        '{"type": "Feature", "properties": {}, "geometry": {"type": "Polygon", '
+        '"coordinates": [[[0, 0], [3, 0], [0, 2], [0, 0]]]}}'
+    )
     assert main(["mesh", str(p), "--size", "0.25"]) == 0
     (mesh,) = checked_generate
     assert abs(mesh.area() - 3.0) < 1e-12
@@ -162,30 +198,43 @@ def _square(tmp_path):
     return p
 
 
-@pytest.mark.parametrize("make_args, fragment", [
-    (lambda t: ["mesh", str(t / "missing.poly")], "missing.poly: No such file"),
-    (lambda t: ["mesh", str(_square(t).rename(t / "sq.txt"))], "must be a .poly, .wkt or .geojson"),
-    (lambda t: ["mesh", str(_bad_poly(t))], "bad.poly, line 8: segment endpoint 7"),
-    (lambda t: ["mesh", str(_bow_tie(t))], "bow.wkt: the polygon is not a valid polygon"),
-    (lambda t: ["mesh", str(_square(t)), "--size", "0.1", "--max-triangles", "3"],
-     "sq.wkt: max_triangles=3 is below"),
-    (lambda t: ["mesh", str(_square(t)), "--out", str(t / "sq.xyz")], "'sq.xyz'"),
-    (lambda t: ["mesh", str(_square(t)), "--out", str(t / "no" / "dir" / "sq.poly")],
-     "No such file or directory"),
-])
+@pytest.mark.parametrize(
+    "make_args, fragment",
+    [
+        (lambda t: ["mesh", str(t / "missing.poly")], "missing.poly: No such file"),
+        (
+            lambda t: ["mesh", str(_square(t).rename(t / "sq.txt"))],
+            "must be a .poly, .wkt or .geojson",
+        ),
+        (lambda t: ["mesh", str(_bad_poly(t))], "bad.poly, line 8: segment endpoint 7"),
+        (lambda t: ["mesh", str(_bow_tie(t))], "bow.wkt: the polygon is not a valid polygon"),
+        (
+            lambda t: ["mesh", str(_square(t)), "--size", "0.1", "--max-triangles", "3"],
+            "sq.wkt: max_triangles=3 is below",
+        ),
+        (lambda t: ["mesh", str(_square(t)), "--out", str(t / "sq.xyz")], "'sq.xyz'"),
+        (
+            lambda t: ["mesh", str(_square(t)), "--out", str(t / "no" / "dir" / "sq.poly")],
+            "No such file or directory",
+        ),
+    ],
+)
 def test_bad_input_exits_2_with_one_line(tmp_path, capsys, make_args, fragment):
     assert main(make_args(tmp_path)) == 2
     line = _error_line(capsys)
     assert line.startswith("aftmesh: error: ") and fragment in line, line
 
 
-@pytest.mark.parametrize("argv, fragment", [
-    (["mesh", "x.wkt", "--size", "-1"], "--size: must be a finite positive number"),
-    (["mesh", "x.wkt", "--size", "abc"], "not a number"),
-    (["mesh", "x.wkt", "--order", "random"], "invalid choice: 'random'"),
-    (["frobnicate"], "invalid choice"),
-    ([], "required: COMMAND"),
-])
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["mesh", "x.wkt", "--size", "-1"], "--size: must be a finite positive number"),
+        (["mesh", "x.wkt", "--size", "abc"], "not a number"),
+        (["mesh", "x.wkt", "--order", "random"], "invalid choice: 'random'"),
+        (["frobnicate"], "invalid choice"),
+        ([], "required: COMMAND"),
+    ],
+)
 def test_usage_errors_exit_2(capsys, argv, fragment):
     assert main(argv) == 2
     err = capsys.readouterr().err
@@ -213,24 +262,35 @@ def test_python_dash_m(tmp_path):
     wkt = _square(tmp_path)
     src = str(Path(aftmesh.__file__).resolve().parents[1])
     env = dict(os.environ, PYTHONPATH=src + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    run = subprocess.run([sys.executable, "-m", "aftmesh", "mesh", str(wkt), "--size", "0.5"],
-                         capture_output=True, text=True, env=env, timeout=120)
+    run = subprocess.run(
+        [sys.executable, "-m", "aftmesh", "mesh", str(wkt), "--size", "0.5"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert run.returncode == 0, run.stderr
     assert run.stdout.startswith("sq.wkt: ") and " triangles, " in run.stdout
-    bad = subprocess.run([sys.executable, "-m", "aftmesh", "mesh", str(tmp_path / "no.wkt")],
-                         capture_output=True, text=True, env=env, timeout=120)
+    bad = subprocess.run(
+        [sys.executable, "-m", "aftmesh", "mesh", str(tmp_path / "no.wkt")],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
 
 
 # ------------------------------------------------------------------ example domains
+
 
 def test_naca0012_shape():
     xy = examples.naca0012(spacing=0.005)
     n = len(xy)
     assert xy[0].tolist() == [1.0, 0.0] and xy[n // 2].tolist() == [0.0, 0.0]
     # symmetric, 12 % thick near 30 % of the chord, counter-clockwise
-    np.testing.assert_array_equal(xy[1:n // 2, 0], xy[:n // 2:-1, 0])
-    np.testing.assert_array_equal(xy[1:n // 2, 1], -xy[:n // 2:-1, 1])
+    np.testing.assert_array_equal(xy[1 : n // 2, 0], xy[: n // 2 : -1, 0])
+    np.testing.assert_array_equal(xy[1 : n // 2, 1], -xy[: n // 2 : -1, 1])
     top = np.argmax(xy[:, 1])
     assert abs(2 * xy[top, 1] - 0.12) < 1e-4 and abs(xy[top, 0] - 0.3) < 0.01
     assert shapely.Polygon(xy).exterior.is_ccw
@@ -238,9 +298,8 @@ def test_naca0012_shape():
     assert steps.max() < 0.005 * 1.01 and steps.min() > 0.005 * 0.9
     # the thickness formula at x = 0.5: 5 t (0.2969 sqrt(x) - ...)
     x = 0.5
-    yt = 0.6 * (0.2969 * x ** 0.5 - 0.1260 * x - 0.3516 * x ** 2 + 0.2843 * x ** 3
-                - 0.1036 * x ** 4)
-    upper = xy[:n // 2 + 1][::-1]
+    yt = 0.6 * (0.2969 * x**0.5 - 0.1260 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
+    upper = xy[: n // 2 + 1][::-1]
     assert abs(np.interp(x, upper[:, 0], upper[:, 1]) - yt) < 1e-5
 
 

@@ -1,23 +1,22 @@
 """Input forms of ``aftmesh.generate`` (issue "Domains, sizes and the user-facing API"):
 every accepted form gives a valid mesh of the right domain; every bad input raises the
 ``ValueError`` subclass that names the problem, never an IndexError or a crash."""
+
 from __future__ import annotations
 
 import re
 
+import domain_cases as dc
 import numpy as np
 import pytest
 import shapely
 import triangle
 from hypothesis import given
 from hypothesis import strategies as st
-from shapely.geometry import (GeometryCollection, LineString, MultiPolygon, Point,
-                              Polygon, box)
+from shapely.geometry import GeometryCollection, LineString, MultiPolygon, Point, Polygon, box
 
 import aftmesh
 from aftmesh.checks import check_mesh, count_formula
-
-import domain_cases as dc
 
 
 def valid(mesh, area, *, edges=None, delaunay=True):
@@ -38,10 +37,11 @@ def centroids(mesh):
 
 def region_areas(mesh) -> dict:
     p = np.asarray(mesh.points)[np.asarray(mesh.triangles)]
-    a = 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-               - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
-    return {int(r): float(a[np.asarray(mesh.regions) == r].sum())
-            for r in np.unique(mesh.regions)}
+    a = 0.5 * (
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
+    return {int(r): float(a[np.asarray(mesh.regions) == r].sum()) for r in np.unique(mesh.regions)}
 
 
 def covered_by_segments(mesh, a, b, tol=1e-9) -> bool:
@@ -113,9 +113,11 @@ def test_geometry_collection_line_splits_domain():
     assert ((x.max(axis=1) <= 1) | (x.min(axis=1) >= 1)).all()
 
 
-@pytest.mark.parametrize("line", [[(1.0, 0.0), (1.0, 0.6)], [(0.5, 0.5), (1.5, 0.5)],
-                                  [(0.3, 0.2), (1.6, 0.7)]],
-                         ids=["from-boundary", "interior", "slanted"])
+@pytest.mark.parametrize(
+    "line",
+    [[(1.0, 0.0), (1.0, 0.6)], [(0.5, 0.5), (1.5, 0.5)], [(0.3, 0.2), (1.6, 0.7)]],
+    ids=["from-boundary", "interior", "slanted"],
+)
 def test_geometry_collection_crack(line):
     """A constraint line with a free end (a crack): a segment with triangles on both
     sides, its free end a vertex."""
@@ -128,8 +130,9 @@ def test_geometry_collection_crack(line):
     # every piece of the crack is an interior edge: two triangles on it
     P = np.asarray(mesh.points)
     S = np.asarray(mesh.segments)
-    on = dc.points_on_edges(P[S[:, 0]], np.array([line]), 1e-9) & \
-        dc.points_on_edges(P[S[:, 1]], np.array([line]), 1e-9)
+    on = dc.points_on_edges(P[S[:, 0]], np.array([line]), 1e-9) & dc.points_on_edges(
+        P[S[:, 1]], np.array([line]), 1e-9
+    )
     T = np.asarray(mesh.triangles)
     e = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)
     uniq, counts = np.unique(e, axis=0, return_counts=True)
@@ -145,8 +148,11 @@ def test_inclusion_regions():
     mesh = valid(aftmesh.generate([ring, core], 0.25), 12.0)
     assert region_areas(mesh) == pytest.approx({0: 10.0, 1: 2.0}, rel=1e-12)
     shared = _shared_edge_vertices(
-        mesh, lambda p: (p[0] in (1.0, 3.0) and 1 <= p[1] <= 2) or
-        (p[1] in (1.0, 2.0) and 1 <= p[0] <= 3))
+        mesh,
+        lambda p: (
+            (p[0] in (1.0, 3.0) and 1 <= p[1] <= 2) or (p[1] in (1.0, 2.0) and 1 <= p[0] <= 3)
+        ),
+    )
     assert shared[0] == shared[1] and len(shared[0]) >= 12
     assert len(count_formula(mesh)) == 1
 
@@ -235,8 +241,8 @@ def shortest_edge(mesh) -> float:
 def test_regression_hole_vertex_inside_exterior_edge():
     poly = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(2, 0), (3, 2), (1, 2)]])
     mesh = valid(aftmesh.generate(poly, 0.5), poly.area)
-    assert shortest_edge(mesh) > 0.1          # 4.4e-16: (1.9999999999999996, 0) and (2, 0)
-    assert mesh.quality()["min_angle"] > 5    # 0.0
+    assert shortest_edge(mesh) > 0.1  # 4.4e-16: (1.9999999999999996, 0) and (2, 0)
+    assert mesh.quality()["min_angle"] > 5  # 0.0
 
 
 def test_regression_multipolygon_vertex_inside_edge():
@@ -248,7 +254,7 @@ def test_regression_multipolygon_vertex_inside_edge():
 def test_regression_constraint_end_on_boundary_edge():
     gc = GeometryCollection([box(0, 0, 2, 1), LineString([(1, 0), (1, 0.6)])])
     mesh = valid(aftmesh.generate(gc, 0.1), 2.0)
-    assert shortest_edge(mesh) > 0.02         # 3.3e-16
+    assert shortest_edge(mesh) > 0.02  # 3.3e-16
     gc = GeometryCollection([box(0, 0, 2, 1), Point(1.0, 0.0)])
     mesh = valid(aftmesh.generate(gc, 0.1), 2.0)
     assert shortest_edge(mesh) > 0.02
@@ -275,11 +281,35 @@ def test_regression_repeated_closing_vertex_zero_division():
 
 
 def test_triangle_style_dict_with_holes_and_regions():
-    d = dict(vertices=[(0, 0), (2.5, 0), (4, 0), (4, 4), (2.5, 4), (0, 4),
-                       (1, 1), (2, 1), (2, 2), (1, 2)],
-             segments=[(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 0), (1, 4),
-                       (6, 7), (7, 8), (8, 9), (9, 6)],
-             holes=[(1.5, 1.5)], regions=[(0.5, 3, 10, 0), (3, 3, 20, 0)])
+    d = dict(
+        vertices=[
+            (0, 0),
+            (2.5, 0),
+            (4, 0),
+            (4, 4),
+            (2.5, 4),
+            (0, 4),
+            (1, 1),
+            (2, 1),
+            (2, 2),
+            (1, 2),
+        ],
+        segments=[
+            (0, 1),
+            (1, 2),
+            (2, 3),
+            (3, 4),
+            (4, 5),
+            (5, 0),
+            (1, 4),
+            (6, 7),
+            (7, 8),
+            (8, 9),
+            (9, 6),
+        ],
+        holes=[(1.5, 1.5)],
+        regions=[(0.5, 3, 10, 0), (3, 3, 20, 0)],
+    )
     for kw in ({"size": 0.4}, {"size": None, "split_boundary": False}):
         mesh = valid(aftmesh.generate(d, **kw), 15.0)
         assert region_areas(mesh) == pytest.approx({10: 9.0, 20: 6.0}, rel=1e-12)
@@ -304,14 +334,19 @@ def test_dict_nested_regions_match_triangle():
     each region marker is the one Triangle's regional attributes ('A') give."""
     rings = [box(-k, -k, k, k).exterior.coords[:-1] for k in (4, 3, 2, 1)]
     V = np.concatenate([np.asarray(r, dtype=float) for r in rings])
-    S = np.concatenate([np.c_[np.arange(4), (np.arange(4) + 1) % 4] + 4 * i
-                        for i in range(4)])
-    d = dict(vertices=V, segments=S, holes=np.array([[0.0, 0.0]]),
-             regions=np.array([[3.5, 0, 7, 0], [2.5, 0, 8, 0], [0, 1.5, 9, 0]]))
+    S = np.concatenate([np.c_[np.arange(4), (np.arange(4) + 1) % 4] + 4 * i for i in range(4)])
+    d = dict(
+        vertices=V,
+        segments=S,
+        holes=np.array([[0.0, 0.0]]),
+        regions=np.array([[3.5, 0, 7, 0], [2.5, 0, 8, 0], [0, 1.5, 9, 0]]),
+    )
     ref = triangle.triangulate(d, "pA")
     p = ref["vertices"][ref["triangles"]]
-    a = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                     - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    a = 0.5 * np.abs(
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
     att = ref["triangle_attributes"][:, 0]
     expected = {int(k): float(a[att == k].sum()) for k in np.unique(att)}
     assert expected == pytest.approx({7: 28.0, 8: 20.0, 9: 12.0})
@@ -346,6 +381,7 @@ def test_size_callable_called_on_arrays_a_few_times():
         assert isinstance(x, np.ndarray) and isinstance(y, np.ndarray)
         assert np.shape(x) == np.shape(y)
         return 0.06 + 0.1 * x
+
     poly = box(0, 0, 2, 1)
     mesh = valid(aftmesh.generate(poly, size), 2.0)
     assert len(mesh.points) > 100
@@ -374,7 +410,7 @@ def test_size_none_from_edge_lengths():
     mesh = valid(aftmesh.generate(ring), Polygon(ring).area)
     E = np.stack([ring, np.roll(ring, -1, axis=0)], axis=1)
     assert dc.edge_keys(mesh.points, mesh.segments) == dc.input_edge_keys(E)
-    assert len(mesh.points) > 24     # but the interior is meshed with new points
+    assert len(mesh.points) > 24  # but the interior is meshed with new points
 
 
 def test_size_none_follows_local_edge_length():
@@ -385,14 +421,17 @@ def test_size_none_follows_local_edge_length():
     mesh = valid(aftmesh.generate(ring, split_boundary=False), 8.0)
     p = np.asarray(mesh.points)[np.asarray(mesh.triangles)]
     cy = p[..., 1].mean(axis=1)
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    area = 0.5 * np.abs(
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
     assert area[cy < 0.3].mean() < area[cy > 1.5].mean()
 
 
 # ---------------------------------------------------------------------- bad input
-@pytest.mark.parametrize("ring", [[(0, 0), (1, 1), (1, 0), (0, 1)],
-                                  [(0, 0), (2, 0), (2, 2), (1, -1), (0, 2)]])
+@pytest.mark.parametrize(
+    "ring", [[(0, 0), (1, 1), (1, 0), (0, 1)], [(0, 0), (2, 0), (2, 2), (1, -1), (0, 2)]]
+)
 def test_self_intersecting_exterior_ring(ring):
     with pytest.raises(aftmesh.InvalidDomainError, match="exterior ring"):
         aftmesh.generate(ring, 0.3)
@@ -401,9 +440,10 @@ def test_self_intersecting_exterior_ring(ring):
 
 
 def test_self_intersecting_hole_named():
-    poly = Polygon(box(0, 0, 4, 4).exterior.coords,
-                   [box(0.2, 0.2, 0.5, 0.5).exterior.coords,
-                    [(1, 1), (2, 2), (2, 1), (1, 2)]])
+    poly = Polygon(
+        box(0, 0, 4, 4).exterior.coords,
+        [box(0.2, 0.2, 0.5, 0.5).exterior.coords, [(1, 1), (2, 2), (2, 1), (1, 2)]],
+    )
     with pytest.raises(aftmesh.InvalidDomainError, match="hole 1"):
         aftmesh.generate(poly, 0.3)
 
@@ -419,11 +459,14 @@ def test_invalid_region_named():
         aftmesh.generate([box(0, 0, 1, 1), Polygon([(1, 0), (2, 1), (2, 0), (1, 1)])], 0.3)
 
 
-@pytest.mark.parametrize("regions, names", [
-    ([box(0, 0, 2, 2), box(1, 1, 3, 3)], ("0", "1")),
-    ([box(0, 0, 1, 1), box(2, 0, 3, 1), box(2.5, 0.5, 4, 2)], ("1", "2")),
-    ([box(0, 0, 4, 4), box(1, 1, 2, 2)], ("0", "1")),
-])
+@pytest.mark.parametrize(
+    "regions, names",
+    [
+        ([box(0, 0, 2, 2), box(1, 1, 3, 3)], ("0", "1")),
+        ([box(0, 0, 1, 1), box(2, 0, 3, 1), box(2.5, 0.5, 4, 2)], ("1", "2")),
+        ([box(0, 0, 4, 4), box(1, 1, 2, 2)], ("0", "1")),
+    ],
+)
 def test_overlapping_regions_named(regions, names):
     with pytest.raises(aftmesh.InvalidDomainError) as err:
         aftmesh.generate(regions, 0.3)
@@ -432,20 +475,26 @@ def test_overlapping_regions_named(regions, names):
     assert re.search(rf"\b{names[0]}\b.*\b{names[1]}\b", msg), msg
 
 
-@pytest.mark.parametrize("size", [0, -1, -0.5, float("nan"), float("inf"), -float("inf"),
-                                  "big", [0.1, 0.2], object()])
+@pytest.mark.parametrize(
+    "size", [0, -1, -0.5, float("nan"), float("inf"), -float("inf"), "big", [0.1, 0.2], object()]
+)
 def test_bad_size_values(size):
     with pytest.raises(aftmesh.InvalidSizeError):
         aftmesh.generate(box(0, 0, 1, 1), size)
 
 
-@pytest.mark.parametrize("bad, region", [
-    (lambda x, y: np.where(x > 0.5, np.nan, 0.2), lambda x, y: x > 0.5 - 1e-5),
-    (lambda x, y: 0.2 - y, lambda x, y: y > 0.2 - 1e-5),
-    (lambda x, y: np.where((x - 1) ** 2 + (y - 1) ** 2 < 0.01, -1.0, 0.2),
-     lambda x, y: (x - 1) ** 2 + (y - 1) ** 2 < 0.0101),
-    (lambda x, y: np.where(x < 0.25, np.inf, 0.2), lambda x, y: x < 0.25 + 1e-5),
-])
+@pytest.mark.parametrize(
+    "bad, region",
+    [
+        (lambda x, y: np.where(x > 0.5, np.nan, 0.2), lambda x, y: x > 0.5 - 1e-5),
+        (lambda x, y: 0.2 - y, lambda x, y: y > 0.2 - 1e-5),
+        (
+            lambda x, y: np.where((x - 1) ** 2 + (y - 1) ** 2 < 0.01, -1.0, 0.2),
+            lambda x, y: (x - 1) ** 2 + (y - 1) ** 2 < 0.0101,
+        ),
+        (lambda x, y: np.where(x < 0.25, np.inf, 0.2), lambda x, y: x < 0.25 + 1e-5),
+    ],
+)
 def test_size_callable_bad_somewhere(bad, region):
     with pytest.raises(aftmesh.InvalidSizeError) as err:
         aftmesh.generate(box(0, 0, 2, 2), bad)
@@ -464,14 +513,26 @@ def test_size_callable_failing_or_wrong_shape():
         aftmesh.generate(box(0, 0, 1, 1), lambda x, y: "small")
 
 
-@pytest.mark.parametrize("option", [
-    {"order": "sideways"}, {"order": None}, {"order": 0},
-    {"max_triangles": 0}, {"max_triangles": -3}, {"max_triangles": 2.5},
-    {"max_triangles": True}, {"max_triangles": "10"},
-    {"min_area": -1.0}, {"min_area": float("nan")}, {"min_area": float("inf")},
-    {"close_factor": 2.0}, {"close_factor": -0.1}, {"close_factor": float("nan")},
-    {"smooth": -1},
-])
+@pytest.mark.parametrize(
+    "option",
+    [
+        {"order": "sideways"},
+        {"order": None},
+        {"order": 0},
+        {"max_triangles": 0},
+        {"max_triangles": -3},
+        {"max_triangles": 2.5},
+        {"max_triangles": True},
+        {"max_triangles": "10"},
+        {"min_area": -1.0},
+        {"min_area": float("nan")},
+        {"min_area": float("inf")},
+        {"close_factor": 2.0},
+        {"close_factor": -0.1},
+        {"close_factor": float("nan")},
+        {"smooth": -1},
+    ],
+)
 def test_bad_options(option):
     with pytest.raises(aftmesh.InvalidOptionError) as err:
         aftmesh.generate(box(0, 0, 1, 1), 0.3, **option)
@@ -484,42 +545,100 @@ def test_bad_gradation(gradation):
         aftmesh.generate(box(0, 0, 1, 1), 0.3, gradation=gradation)
 
 
-@pytest.mark.parametrize("domain", [
-    Polygon(), MultiPolygon(), GeometryCollection(), [], np.zeros((0, 2)),
-    LineString([(0, 0), (1, 1)]), Point(0, 0), [(0, 0), (1, 1)],
-    [(0, 0), (1, 0), (2, 0)], [(0, 0), (1, 0), (1, 0)],
-    dict(vertices=[(0, 0), (1, 0), (0, 1)]),
-    dict(vertices=np.zeros((0, 2)), segments=[]),
-], ids=["polygon", "multipolygon", "collection", "list", "array", "linestring", "point",
-        "two-points", "collinear", "repeated", "dict-no-segments", "dict-empty"])
+@pytest.mark.parametrize(
+    "domain",
+    [
+        Polygon(),
+        MultiPolygon(),
+        GeometryCollection(),
+        [],
+        np.zeros((0, 2)),
+        LineString([(0, 0), (1, 1)]),
+        Point(0, 0),
+        [(0, 0), (1, 1)],
+        [(0, 0), (1, 0), (2, 0)],
+        [(0, 0), (1, 0), (1, 0)],
+        dict(vertices=[(0, 0), (1, 0), (0, 1)]),
+        dict(vertices=np.zeros((0, 2)), segments=[]),
+    ],
+    ids=[
+        "polygon",
+        "multipolygon",
+        "collection",
+        "list",
+        "array",
+        "linestring",
+        "point",
+        "two-points",
+        "collinear",
+        "repeated",
+        "dict-no-segments",
+        "dict-empty",
+    ],
+)
 def test_empty_or_degenerate_domains(domain):
     with pytest.raises(aftmesh.InvalidDomainError):
         aftmesh.generate(domain, 0.3)
 
 
-@pytest.mark.parametrize("domain, error, words", [
-    ([(0, 0), (1, np.nan), (1, 1)], aftmesh.InvalidDomainError, ["vertex 1", "finite"]),
-    ([(0, 0), (1, np.inf), (1, 1)], aftmesh.InvalidDomainError, ["vertex 1", "finite"]),
-    (dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, 5)]),
-     aftmesh.InvalidInputError, ["segments[1]"]),
-    (dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, -1)]),
-     aftmesh.InvalidInputError, ["segments[1]"]),
-    (dict(vertices=[(0, 0), (1, 0), (np.nan, 1)], segments=[(0, 1), (1, 2), (2, 0)]),
-     aftmesh.InvalidInputError, ["vertices[2]"]),
-    (dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, 1), (2, 0)]),
-     aftmesh.InvalidInputError, ["segments[1]"]),
-    (dict(vertices=[(0, 0), (1, 0), (1, 1), (0, 1)], segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
-          holes=[(5, 5)]), aftmesh.InvalidDomainError, ["holes[0]"]),
-    (dict(vertices=[(0, 0), (1, 0), (1, 1), (0, 1)], segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
-          regions=[(0.5, 0.5)]), aftmesh.InvalidInputError, ["regions"]),
-    (dict(segments=[(0, 1)]), aftmesh.InvalidInputError, ["vertices"]),
-    (GeometryCollection([box(0, 0, 1, 1), LineString([(0.5, 0.5), (3, 3)])]),
-     aftmesh.InvalidDomainError, ["constraint line 0"]),
-    (GeometryCollection([box(0, 0, 1, 1), Point(3, 3)]),
-     aftmesh.InvalidDomainError, ["fixed point 0"]),
-    (5, aftmesh.InvalidDomainError, ["int"]),
-    ([box(0, 0, 1, 1), "square"], aftmesh.InvalidDomainError, ["region 1"]),
-])
+@pytest.mark.parametrize(
+    "domain, error, words",
+    [
+        ([(0, 0), (1, np.nan), (1, 1)], aftmesh.InvalidDomainError, ["vertex 1", "finite"]),
+        ([(0, 0), (1, np.inf), (1, 1)], aftmesh.InvalidDomainError, ["vertex 1", "finite"]),
+        (
+            dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, 5)]),
+            aftmesh.InvalidInputError,
+            ["segments[1]"],
+        ),
+        (
+            dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, -1)]),
+            aftmesh.InvalidInputError,
+            ["segments[1]"],
+        ),
+        (
+            dict(vertices=[(0, 0), (1, 0), (np.nan, 1)], segments=[(0, 1), (1, 2), (2, 0)]),
+            aftmesh.InvalidInputError,
+            ["vertices[2]"],
+        ),
+        (
+            dict(vertices=[(0, 0), (1, 0), (0, 1)], segments=[(0, 1), (1, 1), (2, 0)]),
+            aftmesh.InvalidInputError,
+            ["segments[1]"],
+        ),
+        (
+            dict(
+                vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
+                segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
+                holes=[(5, 5)],
+            ),
+            aftmesh.InvalidDomainError,
+            ["holes[0]"],
+        ),
+        (
+            dict(
+                vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
+                segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
+                regions=[(0.5, 0.5)],
+            ),
+            aftmesh.InvalidInputError,
+            ["regions"],
+        ),
+        (dict(segments=[(0, 1)]), aftmesh.InvalidInputError, ["vertices"]),
+        (
+            GeometryCollection([box(0, 0, 1, 1), LineString([(0.5, 0.5), (3, 3)])]),
+            aftmesh.InvalidDomainError,
+            ["constraint line 0"],
+        ),
+        (
+            GeometryCollection([box(0, 0, 1, 1), Point(3, 3)]),
+            aftmesh.InvalidDomainError,
+            ["fixed point 0"],
+        ),
+        (5, aftmesh.InvalidDomainError, ["int"]),
+        ([box(0, 0, 1, 1), "square"], aftmesh.InvalidDomainError, ["region 1"]),
+    ],
+)
 def test_bad_input_named(domain, error, words):
     with pytest.raises(error) as err:
         aftmesh.generate(domain, 0.3)
@@ -528,8 +647,10 @@ def test_bad_input_named(domain, error, words):
 
 
 def test_crossing_segments_named():
-    d = dict(vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
-             segments=[(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)])
+    d = dict(
+        vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
+        segments=[(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)],
+    )
     with pytest.raises(aftmesh.CrossingSegmentsError) as err:
         aftmesh.generate(d, split_boundary=False)
     assert set(err.value.segments) == {0, 1}
@@ -540,8 +661,10 @@ def test_regression_crossing_error_names_input_segments():
     """When the size splits the crossing segments, the error names the pieces'
     internal indices (segments[7], segments[2] of a 6-segment input) instead of the
     caller's segments 0 and 1."""
-    d = dict(vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
-             segments=[(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)])
+    d = dict(
+        vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
+        segments=[(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)],
+    )
     with pytest.raises(aftmesh.CrossingSegmentsError) as err:
         aftmesh.generate(d, 0.3)
     assert set(err.value.segments) == {0, 1}, str(err.value)
@@ -549,8 +672,13 @@ def test_regression_crossing_error_names_input_segments():
 
 def test_crossing_constraint_lines_are_noded():
     """Crossing LineStrings in a GeometryCollection are split where they cross."""
-    gc = GeometryCollection([box(0, 0, 2, 2), LineString([(0.5, 0.5), (1.5, 1.5)]),
-                             LineString([(0.5, 1.5), (1.5, 0.5)])])
+    gc = GeometryCollection(
+        [
+            box(0, 0, 2, 2),
+            LineString([(0.5, 0.5), (1.5, 1.5)]),
+            LineString([(0.5, 1.5), (1.5, 0.5)]),
+        ]
+    )
     mesh = valid(aftmesh.generate(gc, 0.2), 4.0)
     assert (1.0, 1.0) in dc.coordinate_keys(mesh.points)
     for a, b in (((0.5, 0.5), (1.5, 1.5)), ((0.5, 1.5), (1.5, 0.5))):
@@ -561,8 +689,10 @@ def test_crossing_constraint_lines_are_noded():
 GRID = st.tuples(st.integers(0, 4), st.integers(0, 4))
 
 
-@given(ring=st.lists(GRID, min_size=0, max_size=8),
-       form=st.sampled_from(["array", "list", "polygon", "dict"]))
+@given(
+    ring=st.lists(GRID, min_size=0, max_size=8),
+    form=st.sampled_from(["array", "list", "polygon", "dict"]),
+)
 def test_any_ring_gives_mesh_or_input_error(ring, form):
     """Grid rings: duplicates, collinear runs, self-intersections, too few points.
     (size=None keeps the edges whole: this exercises input handling.)"""

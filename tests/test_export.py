@@ -1,6 +1,7 @@
 """Export with tags: every format Mesh.write documents, read back by meshio, Triangle's
 reader and scikit-fem's loader, keeps the points, triangles, regions, segments and the
 segments' markers and tags; and the README's finite-element example runs."""
+
 import copy
 import re
 import sys
@@ -42,8 +43,10 @@ def tagged():
     """A 3 x 2 box with named sides, a round hole (untagged boundary) and a square
     core of region 1 (an untagged interface)."""
     core = box(1, 0.5, 2, 1.5)
-    outer = Polygon(box(0, 0, 3, 2).exterior.coords,
-                    [core.exterior.coords, Point(2.5, 1).buffer(0.3, 8).exterior.coords])
+    outer = Polygon(
+        box(0, 0, 3, 2).exterior.coords,
+        [core.exterior.coords, Point(2.5, 1).buffer(0.3, 8).exterior.coords],
+    )
     mesh = aftmesh.generate([outer, core], size=0.2)
     aftmesh.checks.check_mesh(mesh, domain_area=outer.area + core.area)
     tags = side_tags(mesh, 3, 2)
@@ -149,29 +152,41 @@ def test_meshes_without_tags_export_their_markers(tmp_path, checked):
 def test_physical_groups_of_markers_without_names(checked):
     # a dict domain's markers are the user's own numbers: named by number, after the
     # region groups, counted so that marker 0 is not group 0 (no group in Gmsh)
-    square = {"vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
-              "segments": [(0, 1), (1, 2), (2, 3), (3, 0)], "segment_markers": [0, 7, 7, -1]}
+    square = {
+        "vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
+        "segments": [(0, 1), (1, 2), (2, 3), (3, 0)],
+        "segment_markers": [0, 7, 7, -1],
+    }
     m = checked(aftmesh.generate(square, size=0.5))
     tri, seg, names = gmsh_physical_groups(m)
     assert (tri == 1).all()
     np.testing.assert_array_equal(seg, 1 + m.segment_markers + 2)
     assert {k: v.tolist() for k, v in names.items()} == {
-        "region_0": [1, 2], "segment_marker_-1": [2, 1], "segment_marker_0": [3, 1],
-        "segment_marker_7": [10, 1]}
+        "region_0": [1, 2],
+        "segment_marker_-1": [2, 1],
+        "segment_marker_0": [3, 1],
+        "segment_marker_7": [10, 1],
+    }
 
 
 def test_every_group_keeps_a_name_of_its_own(tagged):
     m = with_tags(tagged, np.minimum(tagged.segment_tags, 1), {"untagged": 1})
     _, seg, names = gmsh_physical_groups(m)
     assert {k: v.tolist() for k, v in names.items()} == {
-        "region_0": [1, 2], "region_1": [2, 2], "untagged": [3, 1], "untagged_4": [4, 1]}
+        "region_0": [1, 2],
+        "region_1": [2, 2],
+        "untagged": [3, 1],
+        "untagged_4": [4, 1],
+    }
     np.testing.assert_array_equal(seg, np.where(m.segment_tags == 1, 3, 4))
 
 
 def test_negative_regions_still_get_positive_groups(checked):
-    square = {"vertices": [(0, 0), (2, 0), (2, 1), (0, 1), (1, 0), (1, 1)],
-              "segments": [(0, 4), (4, 1), (1, 2), (2, 5), (5, 3), (3, 0), (4, 5)],
-              "regions": [(0.5, 0.5, -3), (1.5, 0.5, 2)]}
+    square = {
+        "vertices": [(0, 0), (2, 0), (2, 1), (0, 1), (1, 0), (1, 1)],
+        "segments": [(0, 4), (4, 1), (1, 2), (2, 5), (5, 3), (3, 0), (4, 5)],
+        "regions": [(0.5, 0.5, -3), (1.5, 0.5, 2)],
+    }
     m = checked(aftmesh.generate(square, size=0.5))
     tri, seg, names = gmsh_physical_groups(m)
     np.testing.assert_array_equal(tri, m.regions + 4)
@@ -188,14 +203,17 @@ def test_xdmf_without_h5py_says_what_to_install(tmp_path, tagged, monkeypatch):
 
 def test_io_extra_has_what_every_advertised_format_needs():
     import tomllib
+
     extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"][
-        "optional-dependencies"]
+        "optional-dependencies"
+    ]
     names = {k: {re.split(r"[<>=!~ ]", r)[0] for r in v} for k, v in extras.items()}
     assert {"meshio", "h5py"} <= names["io"]
     assert {"meshio", "h5py", "scikit-fem"} <= names["test"]
 
 
 # ------------------------------------------------------------------ scikit-fem
+
 
 def test_scikit_fem_finds_the_tagged_boundaries_and_the_regions(tmp_path, tagged):
     skfem = pytest.importorskip("skfem")
@@ -208,8 +226,9 @@ def test_scikit_fem_finds_the_tagged_boundaries_and_the_regions(tmp_path, tagged
     np.testing.assert_array_equal(fem.t.T, np.sort(m.triangles, axis=1))
     assert set(fem.subdomains) == {"region_0", "region_1"}
     for r in (0, 1):
-        np.testing.assert_array_equal(np.sort(fem.subdomains[f"region_{r}"]),
-                                      np.flatnonzero(m.regions == r))
+        np.testing.assert_array_equal(
+            np.sort(fem.subdomains[f"region_{r}"]), np.flatnonzero(m.regions == r)
+        )
     # scikit-fem keeps boundary facets only: the interface is untagged and inside
     on_boundary = _boundary_segment(m)
     assert set(fem.boundaries) == {*SIDES, "untagged"}
@@ -226,6 +245,7 @@ def test_poisson_with_a_dirichlet_side_from_the_exported_file(tmp_path, checked)
     skfem = pytest.importorskip("skfem")
     pytest.importorskip("meshio")
     from skfem.helpers import dot, grad
+
     mesh = checked(aftmesh.generate(box(0, 0, 1, 1), size=0.1))
     tags = (mesh.points[mesh.segments].mean(axis=1)[:, 0] == 0).astype(np.int32)
     mesh = with_tags(mesh, tags, {"left": 1})
@@ -245,18 +265,22 @@ def test_poisson_with_a_dirichlet_side_from_the_exported_file(tmp_path, checked)
 
 # ------------------------------------------------------------------ the README example
 
+
 def readme_example(marker: str) -> str:
     """The code block after ``<!-- readme-example: marker -->`` in README.md."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    found = re.search(rf"<!-- readme-example: {re.escape(marker)} -->\s*```python\n(.*?)```",
-                      text, re.DOTALL)
+    found = re.search(
+        rf"<!-- readme-example: {re.escape(marker)} -->\s*```python\n(.*?)```", text, re.DOTALL
+    )
     assert found, f"README.md has no code block marked readme-example: {marker}"
     return found.group(1)
 
 
-@pytest.mark.xfail(not hasattr(aftmesh.Mesh, "boundary_facets"), strict=True,
-                   reason="generate(boundary_tags=) and Mesh.boundary_facets come with "
-                          "branch py")
+@pytest.mark.xfail(
+    not hasattr(aftmesh.Mesh, "boundary_facets"),
+    strict=True,
+    reason="generate(boundary_tags=) and Mesh.boundary_facets come with branch py",
+)
 def test_readme_poisson_example_runs(tmp_path, monkeypatch, capsys):
     pytest.importorskip("skfem")
     pytest.importorskip("meshio")
@@ -275,6 +299,8 @@ def test_readme_poisson_example_runs(tmp_path, monkeypatch, capsys):
     assert np.abs(u - (x - x * x / 2)).max() < 2e-3
     # the file it wrote has the same side, for scikit-fem
     import skfem
+
     fem = skfem.MeshTri.load(tmp_path / "square.msh")
-    assert _pairs(fem.facets[:, fem.boundaries["left"]].T) == \
-        _pairs(mesh.segments[namespace["left"]])
+    assert _pairs(fem.facets[:, fem.boundaries["left"]].T) == _pairs(
+        mesh.segments[namespace["left"]]
+    )

@@ -1,6 +1,7 @@
 """Real GIS input: messages that say where an invalid polygon or a stray line is,
 ``repair=True`` (shapely.make_valid), ``tolerance=`` (merge near vertices, snap line
 ends), and input vertices on straight edges kept."""
+
 import re
 
 import numpy as np
@@ -24,9 +25,11 @@ from aftmesh.mesh import triangle_quality
 
 # an exterior that touches itself at (2, 0) (a spike folded back onto the ring)
 SELF_TOUCHING = [(0, 0), (2, 0), (3, 1), (2, 0), (4, 0), (4, 4), (0, 4)]
-HOLES = [[(0.5, 2), (1.5, 2), (1.5, 3), (0.5, 3)],      # hole 0
-         [(3, 3), (3.5, 3), (3.5, 3.5)],                # hole 1
-         [(1, 2.5), (2, 2.5), (2, 3.5), (1, 3.5)]]      # hole 2 overlaps hole 0
+HOLES = [
+    [(0.5, 2), (1.5, 2), (1.5, 3), (0.5, 3)],  # hole 0
+    [(3, 3), (3.5, 3), (3.5, 3.5)],  # hole 1
+    [(1, 2.5), (2, 2.5), (2, 3.5), (1, 3.5)],
+]  # hole 2 overlaps hole 0
 
 
 def _coordinates(msg):
@@ -88,8 +91,10 @@ def test_repair_meshes_a_self_touching_polygon_and_reports_the_sliver(checked):
     assert "sliver of length 1" in dropped and "(6.0, 6.0)" in dropped, rep
     # the crack inside the repaired domain stays a constraint
     P = mesh.points
-    on_crack = [np.isclose(P[s, 0], P[s, 1]).all() and (P[s] > 0.99).all() and (P[s] < 3.01).all()
-                for s in mesh.segments]
+    on_crack = [
+        np.isclose(P[s, 0], P[s, 1]).all() and (P[s] > 0.99).all() and (P[s] < 3.01).all()
+        for s in mesh.segments
+    ]
     assert sum(on_crack) >= 3
     checked(aftmesh.generate(bow, 0.2, repair=True), domain_area=2.0)
 
@@ -128,8 +133,13 @@ def test_tolerance_merges_line_ends_closer_than_it(checked):
 
 def test_tolerance_snaps_a_line_end_onto_a_line(checked):
     # a line ending 1e-12 short of another line's interior (a T-junction)
-    domain = GeometryCollection([box(0, 0, 2, 2), LineString([(0.2, 1.0), (1.8, 1.0)]),
-                                 LineString([(1.0, 0.3), (1.0, 1.0 - 1e-12)])])
+    domain = GeometryCollection(
+        [
+            box(0, 0, 2, 2),
+            LineString([(0.2, 1.0), (1.8, 1.0)]),
+            LineString([(1.0, 0.3), (1.0, 1.0 - 1e-12)]),
+        ]
+    )
     mesh = checked(aftmesh.generate(domain, 0.2, tolerance=1e-9), domain_area=4.0)
     assert mesh.info["tolerance"]["snapped"] >= 1, mesh.info["tolerance"]
     assert triangle_quality(mesh.points, mesh.triangles)["min_angle"].min() > 15
@@ -144,9 +154,8 @@ def test_tolerance_zero_is_exact_and_unreported():
 
 @pytest.mark.parametrize("form", ["polygon", "ring", "regions"])
 def test_input_vertex_in_the_middle_of_a_straight_edge_is_a_mesh_vertex(checked, form):
-    ring = [(0, 0), (0.37, 0), (1, 0), (1, 1), (0, 1)]       # (0.37, 0) is a load point
-    domain = {"polygon": Polygon(ring), "ring": np.array(ring),
-              "regions": [Polygon(ring)]}[form]
+    ring = [(0, 0), (0.37, 0), (1, 0), (1, 1), (0, 1)]  # (0.37, 0) is a load point
+    domain = {"polygon": Polygon(ring), "ring": np.array(ring), "regions": [Polygon(ring)]}[form]
     mesh = checked(aftmesh.generate(domain, 0.3), domain_area=1.0)
     assert ((mesh.points[:, 0] == 0.37) & (mesh.points[:, 1] == 0.0)).any()
     assert not any("collinear" in note for note in mesh.info["cleanup"])
@@ -177,8 +186,9 @@ coords = st.integers(0, 20).map(lambda v: v / 20)
 @given(st.lists(st.tuples(coords, coords), min_size=4, max_size=9))
 def test_repair_meshes_any_ring_with_area(ring):
     repaired = shapely.make_valid(Polygon(ring))
-    area = sum(p.area for p in shapely.get_parts(repaired)
-               if p.geom_type in ("Polygon", "MultiPolygon"))
+    area = sum(
+        p.area for p in shapely.get_parts(repaired) if p.geom_type in ("Polygon", "MultiPolygon")
+    )
     if area < 1e-3:
         with pytest.raises(InvalidDomainError):
             aftmesh.generate(np.array(ring), 0.1, repair=True)
@@ -189,8 +199,13 @@ def test_repair_meshes_any_ring_with_area(ring):
 
 
 @settings(max_examples=30)
-@given(st.lists(st.tuples(coords, coords, st.sampled_from([0.0, 1e-13, -7e-13, 2e-12])),
-                min_size=2, max_size=5))
+@given(
+    st.lists(
+        st.tuples(coords, coords, st.sampled_from([0.0, 1e-13, -7e-13, 2e-12])),
+        min_size=2,
+        max_size=5,
+    )
+)
 def test_nearly_meeting_lines_mesh_with_a_tolerance(joints):
     # a chain of constraint lines inside (0.1, 0.9)^2, each ending a rounding-sized
     # gap away from where the next begins
@@ -211,10 +226,20 @@ def test_nearly_meeting_lines_mesh_with_a_tolerance(joints):
 
 def test_tolerance_on_a_dict_domain_merges_fault_ends(checked):
     # the square's ring, and two fault segments meant to meet at (1, 1)
-    d = {"vertices": [(0, 0), (2, 0), (2, 2), (0, 2), (0.3, 0.4), (1, 1),
-                      (1 + 1.6e-12, 1), (1.6, 1.5)],
-         "segments": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)],
-         "segment_markers": [1, 1, 1, 1, 2, 3]}
+    d = {
+        "vertices": [
+            (0, 0),
+            (2, 0),
+            (2, 2),
+            (0, 2),
+            (0.3, 0.4),
+            (1, 1),
+            (1 + 1.6e-12, 1),
+            (1.6, 1.5),
+        ],
+        "segments": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)],
+        "segment_markers": [1, 1, 1, 1, 2, 3],
+    }
     exact = checked(aftmesh.generate(d, 0.2), domain_area=4.0)
     assert triangle_quality(exact.points, exact.triangles)["min_angle"].min() < 1e-3
     mesh = checked(aftmesh.generate(d, 0.2, tolerance=1e-9), domain_area=4.0)

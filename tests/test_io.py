@@ -1,5 +1,6 @@
 """File input/output (Triangle's .poly/.node/.ele, meshio formats, WKT, GeoJSON) and
 pictures."""
+
 import sys
 from pathlib import Path
 
@@ -12,8 +13,7 @@ from hypothesis.extra.numpy import arrays
 import aftmesh
 from aftmesh import InvalidInputError, InvalidOptionError
 from aftmesh.checks import check_mesh
-from aftmesh.io import (mesh_format, read_geojson, read_poly, read_wkt, write_mesh,
-                        write_poly)
+from aftmesh.io import mesh_format, read_geojson, read_poly, read_wkt, write_mesh, write_poly
 
 triangle = pytest.importorskip("triangle")
 TRIANGLE_DATA = Path(triangle.__file__).parent / "data"
@@ -30,8 +30,11 @@ def two_region_mesh():
     """A mesh with two regions, a hole and an interface (the quick inclusion plus a
     hole in the outer material)."""
     from shapely.geometry import Polygon, box
-    outer = Polygon(box(0, 0, 3, 2).exterior.coords,
-                    [box(1, 0.5, 2, 1.5).exterior.coords, box(2.3, 0.8, 2.7, 1.2).exterior.coords])
+
+    outer = Polygon(
+        box(0, 0, 3, 2).exterior.coords,
+        [box(1, 0.5, 2, 1.5).exterior.coords, box(2.3, 0.8, 2.7, 1.2).exterior.coords],
+    )
     core = box(1, 0.5, 2, 1.5)
     mesh = aftmesh.generate([outer, core], size=0.2)
     check_mesh(mesh, domain_area=outer.area + core.area)
@@ -39,6 +42,7 @@ def two_region_mesh():
 
 
 # ------------------------------------------------------------------ read_poly: samples
+
 
 def test_the_sample_files_are_there():
     # the parametrized test below would silently test nothing without them
@@ -71,9 +75,17 @@ def test_region_lines_as_triangle_reads_them(name):
     # (The triangle package's Python reader puts it in the area column only, and
     # misreads la.1.poly's five-field lines.)
     regions = read_poly(TRIANGLE_DATA / f"{name}.poly")["regions"]
-    np.testing.assert_array_equal(regions, [
-        [6, -0.2, 0.05, 0.05], [25, -0.1, 0.05, 0.05], [5, -1, 0.2, 0.2],
-        [5, -3, 0.4, 0.4], [5, -5, 0.8, 0.8], [5, -10, 3, 3]])
+    np.testing.assert_array_equal(
+        regions,
+        [
+            [6, -0.2, 0.05, 0.05],
+            [25, -0.1, 0.05, 0.05],
+            [5, -1, 0.2, 0.2],
+            [5, -3, 0.4, 0.4],
+            [5, -5, 0.8, 0.8],
+            [5, -10, 3, 3],
+        ],
+    )
 
 
 def test_sample_file_with_fractional_region_attributes_is_refused():
@@ -94,8 +106,11 @@ def test_sample_files_mesh(name, checked):
 
 # ------------------------------------------------------------------ read_poly: format
 
+
 def test_zero_based_file_with_comments_and_missing_optional_fields(tmp_path):
-    p = _write(tmp_path / "z.poly", """
+    p = _write(
+        tmp_path / "z.poly",
+        """
 # a square, vertices numbered from 0
 4 2 1 1   # one attribute, one marker
 0 0 0 7.5 3
@@ -113,7 +128,8 @@ def test_zero_based_file_with_comments_and_missing_optional_fields(tmp_path):
 2
 0 0.25 0.75 3 0.01
 1 0.75 0.75 4
-""")
+""",
+    )
     d = read_poly(p)
     np.testing.assert_array_equal(d["vertices"], [[0, 0], [1, 0], [1, 1], [0, 1]])
     np.testing.assert_array_equal(d["vertex_attributes"], [[7.5], [0], [2.5], [1]])
@@ -156,27 +172,30 @@ _GOOD_HEAD = "3 2 0 0\n1 0 0\n2 1 0\n3 0 1\n"
 _GOOD_SEGS = "3 0\n1 1 2\n2 2 3\n3 3 1\n"
 
 
-@pytest.mark.parametrize("text, line, fragment", [
-    ("3 2 0 0\n1 0 0\n2 1 zero\n3 0 1\n" + _GOOD_SEGS + "0\n", 3, "y must be a number"),
-    ("3 2 0 0\n1 0 0\n2 1 nan\n3 0 1\n" + _GOOD_SEGS + "0\n", 3, "finite"),
-    ("3 3 0 0\n", 1, "dimension must be 2"),
-    ("three 2 0 0\n", 1, "number of vertices must be an integer"),
-    ("-3 2 0 0\n", 1, "must be >= 0"),
-    ("3 2 0 2\n", 1, "boundary markers must be 0 or 1"),
-    ("3 2 0 0\n2 0 0\n", 2, "numbered 0 or 1"),
-    ("3 2 0 0\n1 0 0\n3 1 0\n", 3, "out of sequence"),
-    ("3 2 0 0\n1 0 0\n2 1\n", 3, "needs 3 fields"),
-    ("3 2 0 0\n1 0 0 5\n", 2, "at most 3 expected"),
-    # four vertex lines for three declared: the fourth is read as the segment header
-    ("3 2 0 0\n1 0 0\n2 1 0\n3 0 1\n4 1 1\n" + _GOOD_SEGS, 5, "count declared earlier"),
-    (_GOOD_HEAD + "3 0\n1 1 2\n2 2 4\n3 3 1\n0\n", 7, "endpoint 4 is not a vertex"),
-    (_GOOD_HEAD + "3 0\n1 1 2\n2 2 2\n3 3 1\n0\n", 7, "to itself"),
-    (_GOOD_HEAD + "3 0\n1 1 2\n2 2 x\n3 3 1\n0\n", 7, "integer"),
-    (_GOOD_HEAD + _GOOD_SEGS + "1 2\n", 9, "hole count line"),
-    (_GOOD_HEAD + _GOOD_SEGS + "1\n1 0.1\n", 10, "a hole line"),
-    (_GOOD_HEAD + _GOOD_SEGS + "0\n1\n1 0.1 0.1\n", 11, "a region line"),
-    (_GOOD_HEAD + _GOOD_SEGS + "0\n0\n5\n", 11, "unexpected data"),
-])
+@pytest.mark.parametrize(
+    "text, line, fragment",
+    [
+        ("3 2 0 0\n1 0 0\n2 1 zero\n3 0 1\n" + _GOOD_SEGS + "0\n", 3, "y must be a number"),
+        ("3 2 0 0\n1 0 0\n2 1 nan\n3 0 1\n" + _GOOD_SEGS + "0\n", 3, "finite"),
+        ("3 3 0 0\n", 1, "dimension must be 2"),
+        ("three 2 0 0\n", 1, "number of vertices must be an integer"),
+        ("-3 2 0 0\n", 1, "must be >= 0"),
+        ("3 2 0 2\n", 1, "boundary markers must be 0 or 1"),
+        ("3 2 0 0\n2 0 0\n", 2, "numbered 0 or 1"),
+        ("3 2 0 0\n1 0 0\n3 1 0\n", 3, "out of sequence"),
+        ("3 2 0 0\n1 0 0\n2 1\n", 3, "needs 3 fields"),
+        ("3 2 0 0\n1 0 0 5\n", 2, "at most 3 expected"),
+        # four vertex lines for three declared: the fourth is read as the segment header
+        ("3 2 0 0\n1 0 0\n2 1 0\n3 0 1\n4 1 1\n" + _GOOD_SEGS, 5, "count declared earlier"),
+        (_GOOD_HEAD + "3 0\n1 1 2\n2 2 4\n3 3 1\n0\n", 7, "endpoint 4 is not a vertex"),
+        (_GOOD_HEAD + "3 0\n1 1 2\n2 2 2\n3 3 1\n0\n", 7, "to itself"),
+        (_GOOD_HEAD + "3 0\n1 1 2\n2 2 x\n3 3 1\n0\n", 7, "integer"),
+        (_GOOD_HEAD + _GOOD_SEGS + "1 2\n", 9, "hole count line"),
+        (_GOOD_HEAD + _GOOD_SEGS + "1\n1 0.1\n", 10, "a hole line"),
+        (_GOOD_HEAD + _GOOD_SEGS + "0\n1\n1 0.1 0.1\n", 11, "a region line"),
+        (_GOOD_HEAD + _GOOD_SEGS + "0\n0\n5\n", 11, "unexpected data"),
+    ],
+)
 def test_malformed_poly_names_file_and_line(tmp_path, text, line, fragment):
     p = _write(tmp_path / "bad.poly", text)
     with pytest.raises(InvalidInputError) as info:
@@ -186,14 +205,17 @@ def test_malformed_poly_names_file_and_line(tmp_path, text, line, fragment):
     assert fragment in msg
 
 
-@pytest.mark.parametrize("text, fragment", [
-    ("", "the vertex count line"),
-    ("# only a comment\n", "the vertex count line"),
-    ("3 2 0 0\n1 0 0\n2 1 0\n", "vertex 3 of the 3 declared on line 1"),
-    (_GOOD_HEAD, "the segment count line"),
-    (_GOOD_HEAD + "3 0\n1 1 2\n", "segment 2 of the 3 declared on line 5"),
-    (_GOOD_HEAD + _GOOD_SEGS + "2\n1 0.1 0.1\n", "hole 2 of the 2 declared on line 9"),
-])
+@pytest.mark.parametrize(
+    "text, fragment",
+    [
+        ("", "the vertex count line"),
+        ("# only a comment\n", "the vertex count line"),
+        ("3 2 0 0\n1 0 0\n2 1 0\n", "vertex 3 of the 3 declared on line 1"),
+        (_GOOD_HEAD, "the segment count line"),
+        (_GOOD_HEAD + "3 0\n1 1 2\n", "segment 2 of the 3 declared on line 5"),
+        (_GOOD_HEAD + _GOOD_SEGS + "2\n1 0.1 0.1\n", "hole 2 of the 2 declared on line 9"),
+    ],
+)
 def test_truncated_poly_says_what_is_missing(tmp_path, text, fragment):
     p = _write(tmp_path / "short.poly", text)
     with pytest.raises(InvalidInputError, match="the file ends where") as info:
@@ -209,44 +231,62 @@ def test_malformed_poly_through_generate(tmp_path):
 
 # ------------------------------------------------------------------ write_poly
 
+
 def test_write_poly_round_trip(tmp_path):
     rng = np.random.default_rng(7)
     xy = rng.normal(size=(9, 2)) * 10.0 ** rng.integers(-8, 8, size=(9, 1))
     seg = np.array([[0, 1], [1, 2], [2, 8], [8, 0], [3, 4]])
     holes = rng.random((2, 2))
     p = tmp_path / "rt.poly"
-    write_poly(p, xy, seg, holes=holes, regions=[(0.1, 0.2, 3), (0.3, 0.4, 5)],
-               segment_markers=[1, -2, 3, 4, 0])
+    write_poly(
+        p,
+        xy,
+        seg,
+        holes=holes,
+        regions=[(0.1, 0.2, 3), (0.3, 0.4, 5)],
+        segment_markers=[1, -2, 3, 4, 0],
+    )
     d = read_poly(p)
-    np.testing.assert_array_equal(d["vertices"], xy)       # bit for bit
+    np.testing.assert_array_equal(d["vertices"], xy)  # bit for bit
     np.testing.assert_array_equal(d["segments"], seg)
     np.testing.assert_array_equal(d["segment_markers"], [1, -2, 3, 4, 0])
     np.testing.assert_array_equal(d["holes"], holes)
     # no maximum area given: written as -1, not left for Triangle to copy the attribute
     np.testing.assert_array_equal(d["regions"], [[0.1, 0.2, 3, -1], [0.3, 0.4, 5, -1]])
-    assert "1 1 2 1" in p.read_text().splitlines()           # numbered from 1
+    assert "1 1 2 1" in p.read_text().splitlines()  # numbered from 1
 
 
-@given(arrays(np.float64, st.tuples(st.integers(1, 6), st.just(2)),
-              elements=st.floats(allow_nan=False, allow_infinity=False)))
+@given(
+    arrays(
+        np.float64,
+        st.tuples(st.integers(1, 6), st.just(2)),
+        elements=st.floats(allow_nan=False, allow_infinity=False),
+    )
+)
 def test_write_poly_keeps_every_double(xy):
     import tempfile
+
     with tempfile.TemporaryDirectory() as tmp:
         p = Path(tmp) / "f.poly"
         write_poly(p, xy, None)
         back = read_poly(p)["vertices"]
-    assert back.tobytes() == xy.tobytes()      # bit for bit, -0.0 and subnormals too
+    assert back.tobytes() == xy.tobytes()  # bit for bit, -0.0 and subnormals too
 
 
-@pytest.mark.parametrize("kwargs, fragment", [
-    (dict(vertices=[(0, 0), (1, 0)], segments=[(0, 2)]), "outside 0..1"),
-    (dict(vertices=[(0, 0), (1, np.nan)], segments=None), "not finite"),
-    (dict(vertices=[(0, 0, 0)], segments=None), "shape"),
-    (dict(vertices=[(0, 0), (1, 0)], segments=[(0, 1)], segment_markers=[1, 2]),
-     "2 entries for 1 segments"),
-    (dict(vertices=[(0, 0), (1, 0)], segments=[(0, 0.5)]), "integer"),
-    (dict(vertices=[(0, 0), (1, 0)], segments=None, regions=[(0, 0)]), "regions"),
-])
+@pytest.mark.parametrize(
+    "kwargs, fragment",
+    [
+        (dict(vertices=[(0, 0), (1, 0)], segments=[(0, 2)]), "outside 0..1"),
+        (dict(vertices=[(0, 0), (1, np.nan)], segments=None), "not finite"),
+        (dict(vertices=[(0, 0, 0)], segments=None), "shape"),
+        (
+            dict(vertices=[(0, 0), (1, 0)], segments=[(0, 1)], segment_markers=[1, 2]),
+            "2 entries for 1 segments",
+        ),
+        (dict(vertices=[(0, 0), (1, 0)], segments=[(0, 0.5)]), "integer"),
+        (dict(vertices=[(0, 0), (1, 0)], segments=None, regions=[(0, 0)]), "regions"),
+    ],
+)
 def test_write_poly_rejects_bad_arrays(tmp_path, kwargs, fragment):
     with pytest.raises(InvalidInputError, match=fragment):
         write_poly(tmp_path / "x.poly", **kwargs)
@@ -254,6 +294,7 @@ def test_write_poly_rejects_bad_arrays(tmp_path, kwargs, fragment):
 
 
 # ------------------------------------------------------------------ write_mesh
+
 
 def test_mesh_poly_round_trip_keeps_holes_and_regions(tmp_path, two_region_mesh, checked):
     m = two_region_mesh
@@ -266,13 +307,13 @@ def test_mesh_poly_round_trip_keeps_holes_and_regions(tmp_path, two_region_mesh,
     assert len(d["holes"]) == 1
     # the written file meshes to the same triangulation: same vertices, no new ones,
     # same holes and the same region per triangle
-    again = checked(aftmesh.generate(p, greedy=True, split_boundary=False),
-                    domain_area=m.area())
+    again = checked(aftmesh.generate(p, greedy=True, split_boundary=False), domain_area=m.area())
     assert again.n_triangles == m.n_triangles
 
     def per_region(mesh):
         area = aftmesh.mesh.triangle_quality(mesh.points, mesh.triangles)["area"]
         return {int(r): float(area[mesh.regions == r].sum()) for r in np.unique(mesh.regions)}
+
     assert per_region(again) == pytest.approx(per_region(m))
     assert per_region(m) == pytest.approx({0: 6.0 - 1.0 - 0.16, 1: 1.0})
 
@@ -307,8 +348,10 @@ def test_native_format_by_name(tmp_path, two_region_mesh):
     assert read_poly(tmp_path / "odd2.txt")["vertices"].shape == two_region_mesh.points.shape
 
 
-@pytest.mark.parametrize("name, fmt", [("m.vtu", None), ("m.vtk", None), ("m.msh", None),
-                                       ("m.mesh", None), ("m.data", "vtu")])
+@pytest.mark.parametrize(
+    "name, fmt",
+    [("m.vtu", None), ("m.vtk", None), ("m.msh", None), ("m.mesh", None), ("m.data", "vtu")],
+)
 def test_meshio_round_trip(tmp_path, two_region_mesh, name, fmt):
     meshio = pytest.importorskip("meshio")
     m = two_region_mesh
@@ -329,8 +372,7 @@ def test_meshio_round_trip(tmp_path, two_region_mesh, name, fmt):
     key = {"m.mesh": "medit:ref"}.get(name, "region")
     np.testing.assert_array_equal(np.asarray(back.cell_data[key][0]).astype(int), m.regions)
     key = {"m.mesh": "medit:ref"}.get(name, "segment_marker")
-    np.testing.assert_array_equal(np.asarray(back.cell_data[key][1]).astype(int),
-                                  m.segment_markers)
+    np.testing.assert_array_equal(np.asarray(back.cell_data[key][1]).astype(int), m.segment_markers)
 
 
 def test_mesh_format_resolution():
@@ -353,47 +395,59 @@ def test_unknown_format(tmp_path, two_region_mesh):
 
 
 def test_without_meshio(tmp_path, two_region_mesh, monkeypatch):
-    monkeypatch.setitem(sys.modules, "meshio", None)     # import meshio now fails
+    monkeypatch.setitem(sys.modules, "meshio", None)  # import meshio now fails
     with pytest.raises(ModuleNotFoundError, match=r"pip install aftmesh\[io\]"):
         two_region_mesh.write(tmp_path / "m.vtu")
-    two_region_mesh.write(tmp_path / "m.node")             # native formats still work
+    two_region_mesh.write(tmp_path / "m.node")  # native formats still work
     two_region_mesh.write(tmp_path / "m.poly")
     assert {p.name for p in tmp_path.iterdir()} == {"m.node", "m.ele", "m.poly"}
 
 
 # ------------------------------------------------------------------ WKT and GeoJSON
 
+
 def test_read_wkt_and_mesh(tmp_path, checked):
-    p = _write(tmp_path / "d.wkt", "POLYGON ((0 0, 2 0, 2 1, 0 1, 0 0), "
-                                  "(0.5 0.25, 0.5 0.75, 1 0.75, 1 0.25, 0.5 0.25))\n")
+    p = _write(
+        tmp_path / "d.wkt",
+        "POLYGON ((0 0, 2 0, 2 1, 0 1, 0 0), (0.5 0.25, 0.5 0.75, 1 0.75, 1 0.25, 0.5 0.25))\n",
+    )
     geom = read_wkt(p)
     assert geom.geom_type == "Polygon" and geom.area == 1.75
     checked(aftmesh.generate(geom, size=0.1), domain_area=1.75)
 
 
 def test_read_geojson_feature_collection_with_a_constraint(tmp_path, checked):
-    p = _write(tmp_path / "d.geojson", """{"type": "FeatureCollection", "features": [
+    p = _write(
+        tmp_path / "d.geojson",
+        """{"type": "FeatureCollection", "features": [
       {"type": "Feature", "properties": {},
        "geometry": {"type": "Polygon", "coordinates": [[[0, 0], [2, 0], [2, 1], [0, 1], [0, 0]]]}},
       {"type": "Feature", "properties": {},
-       "geometry": {"type": "LineString", "coordinates": [[0.5, 0.5], [1.5, 0.5]]}}]}""")
+       "geometry": {"type": "LineString", "coordinates": [[0.5, 0.5], [1.5, 0.5]]}}]}""",
+    )
     geom = read_geojson(p)
     assert geom.geom_type == "GeometryCollection"
     mesh = checked(aftmesh.generate(geom, size=0.2), domain_area=2.0)
     # the constraint line is made of mesh segments
     P = mesh.points[mesh.segments]
-    on_line = (P[:, :, 1] == 0.5).all(axis=1) & (P[:, :, 0] >= 0.5).all(axis=1) & \
-        (P[:, :, 0] <= 1.5).all(axis=1)
+    on_line = (
+        (P[:, :, 1] == 0.5).all(axis=1)
+        & (P[:, :, 0] >= 0.5).all(axis=1)
+        & (P[:, :, 0] <= 1.5).all(axis=1)
+    )
     assert np.isclose(np.abs(P[on_line, 1, 0] - P[on_line, 0, 0]).sum(), 1.0)
 
 
-@pytest.mark.parametrize("reader, name, text, fragment", [
-    (read_wkt, "a.wkt", "POLYGON ((0 0, 1 1", "not a valid WKT"),
-    (read_wkt, "a.wkt", "\n  \n", "empty"),
-    (read_wkt, "a.wkt", "POLYGON EMPTY", "empty"),
-    (read_geojson, "a.geojson", '{"type": "Polygon"}', "not a valid GeoJSON"),
-    (read_geojson, "a.geojson", "", "empty"),
-])
+@pytest.mark.parametrize(
+    "reader, name, text, fragment",
+    [
+        (read_wkt, "a.wkt", "POLYGON ((0 0, 1 1", "not a valid WKT"),
+        (read_wkt, "a.wkt", "\n  \n", "empty"),
+        (read_wkt, "a.wkt", "POLYGON EMPTY", "empty"),
+        (read_geojson, "a.geojson", '{"type": "Polygon"}', "not a valid GeoJSON"),
+        (read_geojson, "a.geojson", "", "empty"),
+    ],
+)
 def test_bad_wkt_and_geojson(tmp_path, reader, name, text, fragment):
     p = _write(tmp_path / name, text)
     with pytest.raises(InvalidInputError, match=fragment) as info:
@@ -403,11 +457,14 @@ def test_bad_wkt_and_geojson(tmp_path, reader, name, text, fragment):
 
 # ------------------------------------------------------------------ pictures
 
+
 def test_save_png_and_plot_options(tmp_path, two_region_mesh):
     pytest.importorskip("matplotlib")
     from matplotlib.figure import Figure
     from matplotlib.image import imread
+
     from aftmesh.plotting import plot_mesh, save_png
+
     m = two_region_mesh
     save_png(m, tmp_path / "q.png", dpi=40, zoom=(0.8, 2.2, 0.3, 1.7))
     image = imread(tmp_path / "q.png")
@@ -416,19 +473,30 @@ def test_save_png_and_plot_options(tmp_path, two_region_mesh):
     for color_by in ("quality", "region", "none"):
         fig = Figure()
         ax = m.plot(ax=fig.add_subplot(), color_by=color_by)
-        assert ax.get_title() == (f"{m.n_triangles} triangles, {m.n_points} points, "
-                                  f"min angle {q['min_angle'].min():.1f}\N{DEGREE SIGN}")
+        assert ax.get_title() == (
+            f"{m.n_triangles} triangles, {m.n_points} points, "
+            f"min angle {q['min_angle'].min():.1f}\N{DEGREE SIGN}"
+        )
         assert ax.get_aspect() == 1.0
         # the segments, drawn once, on top
-        assert sum(len(c.get_segments()) for c in ax.collections
-                   if c.__class__.__name__ == "LineCollection") == len(m.segments)
+        assert sum(
+            len(c.get_segments())
+            for c in ax.collections
+            if c.__class__.__name__ == "LineCollection"
+        ) == len(m.segments)
         # a colorbar for quality and region only
         assert len(fig.axes) == (1 if color_by == "none" else 2)
-    ax = plot_mesh(m, ax=Figure().add_subplot(), color_by="region", title="mine",
-                   show_segments=False, colorbar=False)
+    ax = plot_mesh(
+        m,
+        ax=Figure().add_subplot(),
+        color_by="region",
+        title="mine",
+        show_segments=False,
+        colorbar=False,
+    )
     assert ax.get_title() == "mine" and len(ax.figure.axes) == 1
     faces = ax.collections[0].get_array()
-    np.testing.assert_array_equal(faces, m.regions)   # regions 0, 1 -> indices 0, 1
+    np.testing.assert_array_equal(faces, m.regions)  # regions 0, 1 -> indices 0, 1
     with pytest.raises(InvalidOptionError, match="color_by"):
         m.plot(ax=Figure().add_subplot(), color_by="angle")
 
@@ -436,6 +504,7 @@ def test_save_png_and_plot_options(tmp_path, two_region_mesh):
 def test_plotting_without_matplotlib(tmp_path, two_region_mesh, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)
     from aftmesh.plotting import save_png
+
     with pytest.raises(ModuleNotFoundError, match=r"pip install aftmesh\[plot\]"):
         save_png(two_region_mesh, tmp_path / "x.png")
     with pytest.raises(ModuleNotFoundError, match=r"pip install aftmesh\[plot\]"):

@@ -1,6 +1,7 @@
 """``aftmesh.generate_many``: the same meshes as serial ``generate`` calls, by every
 backend (threads, serial, a real Dask cluster of 2 worker processes), with a failing
 domain in the batch raised with its index or collected in its slot."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -11,17 +12,19 @@ import aftmesh
 from aftmesh.parallel import MeshingFailure
 
 BAD_INDEX = 3
-BOWTIE = [(0, 0), (1, 1), (1, 0), (0, 1)]     # a self-crossing ring: InvalidDomainError
+BOWTIE = [(0, 0), (1, 1), (1, 0), (0, 1)]  # a self-crossing ring: InvalidDomainError
 
 
 def batch():
     """Small domains of several input forms, one of them invalid, and their sizes."""
-    domains = [box(0, 0, 1, 1),
-               box(0, 0, 2, 1).difference(Point(0.5, 0.5).buffer(0.2)),
-               [box(0, 0, 1, 1), box(1, 0, 2, 1)],
-               BOWTIE,
-               np.array([(0, 0), (3, 0), (3, 1), (1, 1), (1, 2), (0, 2)], dtype=float),
-               Point(5, 5).buffer(1.0)]
+    domains = [
+        box(0, 0, 1, 1),
+        box(0, 0, 2, 1).difference(Point(0.5, 0.5).buffer(0.2)),
+        [box(0, 0, 1, 1), box(1, 0, 2, 1)],
+        BOWTIE,
+        np.array([(0, 0), (3, 0), (3, 1), (1, 1), (1, 2), (0, 2)], dtype=float),
+        Point(5, 5).buffer(1.0),
+    ]
     sizes = [0.1, 0.08, [0.1, 0.2], 0.1, 0.15, 0.2]
     return domains, sizes
 
@@ -47,6 +50,7 @@ def checked_module():
     def run(mesh, **kw):
         check_mesh(mesh, **kw)
         return mesh
+
     return run
 
 
@@ -61,12 +65,17 @@ def backend(kind, request):
 
 @pytest.mark.parametrize("kind", BACKENDS, ids=["serial", "threads", "dask"])
 def test_generate_many_equals_serial_calls_and_collects_the_failing_domain(
-        kind, request, serial_meshes, checked):
+    kind, request, serial_meshes, checked
+):
     domains, sizes = batch()
     calls = []
-    out = aftmesh.generate_many(domains, sizes, errors="collect",
-                                progress=lambda done, total: calls.append((done, total)),
-                                **backend(kind, request))
+    out = aftmesh.generate_many(
+        domains,
+        sizes,
+        errors="collect",
+        progress=lambda done, total: calls.append((done, total)),
+        **backend(kind, request),
+    )
     assert len(out) == len(domains)
     for i, (mesh, ref) in enumerate(zip(out, serial_meshes)):
         if i == BAD_INDEX:
@@ -101,8 +110,9 @@ def test_dask_batches_of_domains_give_the_same_meshes(dask_client, serial_meshes
 def test_more_domains_than_tasks_in_flight_all_come_back_in_order(kind, request, checked):
     # 2 workers keep at most 8 tasks in flight: 30 domains refill the window many times
     domains = [box(i, 0, i + 1, 1 + 0.1 * i) for i in range(30)]
-    out = aftmesh.generate_many(domains, 0.5, chunksize=2 if kind == "dask" else None,
-                                **backend(kind, request))
+    out = aftmesh.generate_many(
+        domains, 0.5, chunksize=2 if kind == "dask" else None, **backend(kind, request)
+    )
     for i, mesh in enumerate(out):
         assert checked(mesh).area() == pytest.approx(domains[i].area, rel=1e-12)
 
@@ -128,7 +138,7 @@ class DuckFrame:
     def __getitem__(self, name):
         return self._columns[name]
 
-    def __iter__(self):               # a DataFrame iterates over its column names
+    def __iter__(self):  # a DataFrame iterates over its column names
         return iter(self.columns)
 
 
@@ -146,12 +156,15 @@ def test_sizes_not_matching_the_domains_are_refused_naming_both_lengths():
         aftmesh.generate_many(domains, [0.1, 0.2])
 
 
-@pytest.mark.parametrize("options, message", [
-    ({"scheduler": "mpi"}, "scheduler='mpi' is not a valid option"),
-    ({"errors": "ignore"}, "errors='ignore' is not a valid option"),
-    ({"workers": 0}, "workers must be a positive integer"),
-    ({"scheduler": "dask"}, "no active dask.distributed Client"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"scheduler": "mpi"}, "scheduler='mpi' is not a valid option"),
+        ({"errors": "ignore"}, "errors='ignore' is not a valid option"),
+        ({"workers": 0}, "workers must be a positive integer"),
+        ({"scheduler": "dask"}, "no active dask.distributed Client"),
+    ],
+)
 def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(aftmesh.InvalidOptionError, match=message):
         aftmesh.generate_many([box(0, 0, 1, 1)], 0.5, **options)

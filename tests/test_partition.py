@@ -3,8 +3,10 @@ at once and stitched.  The result has the serial mesh's guarantees: a valid
 conforming mesh (check_mesh with the domain's area and input edges), the constrained
 Delaunay triangulation of its vertices and input edges (Triangle as the oracle), the
 serial mesh's region labels and areas, the appendix's count formula per component."""
+
 from __future__ import annotations
 
+import domain_cases as dc
 import numpy as np
 import pytest
 from shapely.geometry import Point, Polygon, box
@@ -13,12 +15,13 @@ import aftmesh
 from aftmesh.checks import count_formula
 from aftmesh.stitch import lawson_flips
 
-import domain_cases as dc
-
 
 def multi_region():
-    regions = [box(0, 0, 1, 1), box(1, 0, 2, 1), box(0, 1, 2, 1.5).difference(
-        Point(1, 1.25).buffer(0.15, quad_segs=4))]
+    regions = [
+        box(0, 0, 1, 1),
+        box(1, 0, 2, 1),
+        box(0, 1, 2, 1.5).difference(Point(1, 1.25).buffer(0.15, quad_segs=4)),
+    ]
     return dc.shapely_case("3-regions", regions, 0.05), [0.05, 0.08, 0.06]
 
 
@@ -26,8 +29,7 @@ def cases():
     holes = dc.many_holes(3, "circle")
     L = dc.l_shape()
     regions, sizes = multi_region()
-    return [(holes, 0.1), (L, 0.06), (regions, sizes), (dc.annulus(), 0.05),
-            (dc.spiral(), 0.15)]
+    return [(holes, 0.1), (L, 0.06), (regions, sizes), (dc.annulus(), 0.05), (dc.spiral(), 0.15)]
 
 
 # the boundaries split at rounded points (off a slanted edge by an ulp) fail check_mesh's
@@ -49,24 +51,27 @@ def region_areas(mesh):
 @pytest.mark.parametrize("case, size", CASES, ids=[c.name for c, _ in CASES])
 def test_partitioned_mesh_is_a_valid_cdt_with_the_serial_regions(case, size, k, checked):
     exact = case.name in EXACT_COVER
-    mesh = checked(aftmesh.generate(case.domain, size, partitions=k),
-                   domain_area=case.area, input_segments=case.edges if exact else None)
+    mesh = checked(
+        aftmesh.generate(case.domain, size, partitions=k),
+        domain_area=case.area,
+        input_segments=case.edges if exact else None,
+    )
     assert "partition_fallback" not in mesh.info
     if k > 1:
         assert mesh.info["partitions"] == k
     dc.assert_cdt(mesh)
     serial = aftmesh.generate(case.domain, size)
     # the same boundary discretization as the serial mesh: the cuts end on its vertices
-    assert dc.edge_keys(mesh.points, mesh.segments) == dc.edge_keys(serial.points,
-                                                                     serial.segments)
+    assert dc.edge_keys(mesh.points, mesh.segments) == dc.edge_keys(serial.points, serial.segments)
     areas, ref = region_areas(mesh), region_areas(serial)
     assert areas.keys() == ref.keys()
     for r in ref:
         assert areas[r] == pytest.approx(ref[r], rel=1e-9)
     for T, E_b, V_i, m in count_formula(mesh):
         assert T == E_b + 2 * V_i + 2 * (m - 1)
-    np.testing.assert_array_equal(np.unique(mesh.segment_markers),
-                                  np.unique(serial.segment_markers))
+    np.testing.assert_array_equal(
+        np.unique(mesh.segment_markers), np.unique(serial.segment_markers)
+    )
 
 
 def test_partitioned_quality_matches_serial_and_cut_triangles_are_good(checked):
@@ -84,8 +89,11 @@ def test_partitioned_quality_matches_serial_and_cut_triangles_are_good(checked):
 def test_parts_meshed_by_dask_tasks_equal_parts_meshed_on_threads(dask_client, checked):
     case, size = CASES[0]
     threads = aftmesh.generate(case.domain, size, partitions=3)
-    dask = checked(aftmesh.generate(case.domain, size, partitions=3, client=dask_client),
-                   domain_area=case.area, input_segments=case.edges)
+    dask = checked(
+        aftmesh.generate(case.domain, size, partitions=3, client=dask_client),
+        domain_area=case.area,
+        input_segments=case.edges,
+    )
     for name in ("points", "triangles", "neighbors", "segments", "regions"):
         np.testing.assert_array_equal(getattr(dask, name), getattr(threads, name))
 
@@ -97,8 +105,13 @@ def test_lawson_flips_make_a_non_delaunay_pair_delaunay(checked):
     N = np.array([(-1, 1, -1), (-1, -1, 0)], dtype=np.int32)
     outline = {0 * 4 + 1, 1 * 4 + 2, 2 * 4 + 3, 0 * 4 + 3}
     flips = lawson_flips(P, T, N, outline, np.array([(0, 1)]))
-    mesh = aftmesh.Mesh(points=P, triangles=T, neighbors=N,
-                        segments=[(0, 1), (1, 2), (2, 3), (3, 0)], regions=[0, 0])
+    mesh = aftmesh.Mesh(
+        points=P,
+        triangles=T,
+        neighbors=N,
+        segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
+        regions=[0, 0],
+    )
     checked(mesh, domain_area=Polygon(P).area)
     assert flips == 1
     assert {tuple(sorted(t)) for t in T.tolist()} == {(0, 1, 3), (1, 2, 3)}
@@ -118,15 +131,20 @@ def marked_edges(mesh) -> dict:
 
 @pytest.mark.parametrize("backend", ["threads", "dask"])
 def test_parts_written_by_their_workers_read_back_as_the_stitched_mesh(
-        backend, request, tmp_path, checked):
+    backend, request, tmp_path, checked
+):
     case, sizes = multi_region()
     client = request.getfixturevalue("dask_client") if backend == "dask" else None
-    index = aftmesh.generate(case.domain, sizes, partitions=3, out=tmp_path / "parts",
-                             client=client)
+    index = aftmesh.generate(
+        case.domain, sizes, partitions=3, out=tmp_path / "parts", client=client
+    )
     assert index == tmp_path / "parts" / "mesh.pvtu"
     assert len(list((tmp_path / "parts").glob("part*.vtu"))) == 3
-    back = checked(aftmesh.read_partitioned(tmp_path / "parts"),
-                   domain_area=case.area, input_segments=case.edges)
+    back = checked(
+        aftmesh.read_partitioned(tmp_path / "parts"),
+        domain_area=case.area,
+        input_segments=case.edges,
+    )
     stitched = aftmesh.generate(case.domain, sizes, partitions=3)
     # the writer skips the Lawson pass across cuts; here it flips nothing anyway
     assert stitched.info["cut_flips"] == 0
@@ -135,12 +153,15 @@ def test_parts_written_by_their_workers_read_back_as_the_stitched_mesh(
     assert region_areas(back) == pytest.approx(region_areas(stitched), rel=1e-12)
 
 
-@pytest.mark.parametrize("options, message", [
-    ({"partitions": 0}, "partitions must be a positive integer, got 0"),
-    ({"partitions": 2.5}, "partitions must be a positive integer"),
-    ({"partitions": 2, "greedy": True}, "greedy=True adds no point"),
-    ({"partitions": 2, "max_triangles": 100}, "max_triangles cannot be combined"),
-])
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"partitions": 0}, "partitions must be a positive integer, got 0"),
+        ({"partitions": 2.5}, "partitions must be a positive integer"),
+        ({"partitions": 2, "greedy": True}, "greedy=True adds no point"),
+        ({"partitions": 2, "max_triangles": 100}, "max_triangles cannot be combined"),
+    ],
+)
 def test_bad_partition_options_are_refused_by_name(options, message):
     with pytest.raises(aftmesh.InvalidOptionError, match=message):
         aftmesh.generate(box(0, 0, 1, 1), 0.1, **options)

@@ -9,6 +9,7 @@ stage B abstains and incircle's may decide) and the exact stage C on its own
 exact rational evaluation, and checks the predicate on every permutation of
 its arguments (the sign must follow the permutation's parity).
 """
+
 import itertools
 import math
 import os
@@ -43,6 +44,7 @@ PROFILE = settings(
 # Oracle and checking helpers
 # ---------------------------------------------------------------------------
 
+
 def sign(x):
     return (x > 0) - (x < 0)
 
@@ -59,9 +61,7 @@ def incircle_oracle(a, b, c, d):
         ex, ey = Fraction(x) - dx, Fraction(y) - dy
         rows.append((ex, ey, ex * ex + ey * ey))
     (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = rows
-    det = (a2 * (b0 * c1 - c0 * b1)
-           + b2 * (c0 * a1 - a0 * c1)
-           + c2 * (a0 * b1 - b0 * a1))
+    det = a2 * (b0 * c1 - c0 * b1) + b2 * (c0 * a1 - a0 * c1) + c2 * (a0 * b1 - b0 * a1)
     return sign(det)
 
 
@@ -73,14 +73,15 @@ def naive_incircle(a, b, c, d):
     adx, ady = a[0] - d[0], a[1] - d[1]
     bdx, bdy = b[0] - d[0], b[1] - d[1]
     cdx, cdy = c[0] - d[0], c[1] - d[1]
-    return sign((adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
-                + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
-                + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady))
+    return sign(
+        (adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
+        + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
+        + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)
+    )
 
 
 def parity(perm):
-    inversions = sum(1 for i, j in itertools.combinations(range(len(perm)), 2)
-                     if perm[i] > perm[j])
+    inversions = sum(1 for i, j in itertools.combinations(range(len(perm)), 2) if perm[i] > perm[j])
     return -1 if inversions % 2 else 1
 
 
@@ -92,8 +93,9 @@ def differences_exact(pts):
     """Whether every coordinate difference p - pts[base] the stages use is exact
     (base: a for orient2d, d for incircle), checked with Fractions."""
     base = pts[0] if len(pts) == 3 else pts[3]
-    return all(Fraction(p[k] - base[k]) == Fraction(p[k]) - Fraction(base[k])
-               for p in pts for k in (0, 1))
+    return all(
+        Fraction(p[k] - base[k]) == Fraction(p[k]) - Fraction(base[k]) for p in pts for k in (0, 1)
+    )
 
 
 def check_orient(a, b, c):
@@ -152,6 +154,7 @@ def nudge(x, ulps):
 # Strategies
 # ---------------------------------------------------------------------------
 
+
 def coords(exp_range):
     lo, hi = exp_range
     mags = st.floats(min_value=2.0**lo, max_value=2.0**hi)
@@ -178,8 +181,8 @@ def lattice_point(draw):
 @st.composite
 def near_1e7_point(draw):
     """Around (1e7, 1e7) with 1e-9 detail (below the 1.86e-9 spacing there)."""
-    i = draw(st.integers(-10**4, 10**4))
-    j = draw(st.integers(-10**4, 10**4))
+    i = draw(st.integers(-(10**4), 10**4))
+    j = draw(st.integers(-(10**4), 10**4))
     return (1e7 + i * 1e-9, 1e7 + j * 1e-9)
 
 
@@ -189,8 +192,7 @@ def near_collinear(draw, base):
     a = draw(base)
     b = draw(base)
     t = draw(st.floats(min_value=-2.0, max_value=3.0))
-    c = (nudge(a[0] + t * (b[0] - a[0]), draw(ulps)),
-         nudge(a[1] + t * (b[1] - a[1]), draw(ulps)))
+    c = (nudge(a[0] + t * (b[0] - a[0]), draw(ulps)), nudge(a[1] + t * (b[1] - a[1]), draw(ulps)))
     return a, b, c
 
 
@@ -203,14 +205,19 @@ def near_cocircular(draw, center_coord, radius):
     pts = []
     for _ in range(4):
         theta = draw(st.floats(min_value=0.0, max_value=2 * math.pi))
-        pts.append((nudge(cx + r * math.cos(theta), draw(ulps)),
-                    nudge(cy + r * math.sin(theta), draw(ulps))))
+        pts.append(
+            (
+                nudge(cx + r * math.cos(theta), draw(ulps)),
+                nudge(cy + r * math.sin(theta), draw(ulps)),
+            )
+        )
     return pts
 
 
 # ---------------------------------------------------------------------------
 # Constants
 # ---------------------------------------------------------------------------
+
 
 def test_error_bound_constants_are_exact():
     ccw, icc = _kernel._pred_error_bounds()
@@ -223,16 +230,20 @@ def test_error_bound_constants_are_exact():
 # Random doubles over the whole documented range
 # ---------------------------------------------------------------------------
 
+
 @PROFILE
-@given(points_of(coords(ORIENT_EXP)), points_of(coords(ORIENT_EXP)),
-       points_of(coords(ORIENT_EXP)))
+@given(points_of(coords(ORIENT_EXP)), points_of(coords(ORIENT_EXP)), points_of(coords(ORIENT_EXP)))
 def test_orient_random_full_range(a, b, c):
     check_orient(a, b, c)
 
 
 @PROFILE
-@given(points_of(coords(INCIRCLE_EXP)), points_of(coords(INCIRCLE_EXP)),
-       points_of(coords(INCIRCLE_EXP)), points_of(coords(INCIRCLE_EXP)))
+@given(
+    points_of(coords(INCIRCLE_EXP)),
+    points_of(coords(INCIRCLE_EXP)),
+    points_of(coords(INCIRCLE_EXP)),
+    points_of(coords(INCIRCLE_EXP)),
+)
 def test_incircle_random_full_range(a, b, c, d):
     check_incircle(a, b, c, d)
 
@@ -244,8 +255,7 @@ def test_orient_random_moderate(a, b, c):
 
 
 @PROFILE
-@given(points_of(moderate), points_of(moderate), points_of(moderate),
-       points_of(moderate))
+@given(points_of(moderate), points_of(moderate), points_of(moderate), points_of(moderate))
 def test_incircle_random_moderate(a, b, c, d):
     check_incircle(a, b, c, d)
 
@@ -253,6 +263,7 @@ def test_incircle_random_moderate(a, b, c, d):
 # ---------------------------------------------------------------------------
 # Tiny lattice around (0.5, 0.5)
 # ---------------------------------------------------------------------------
+
 
 @PROFILE
 @given(lattice_point(), lattice_point(), lattice_point())
@@ -267,8 +278,12 @@ def test_incircle_tiny_lattice(a, b, c, d):
 
 
 @PROFILE
-@given(lattice_point(), lattice_point(), lattice_point(),
-       st.integers(ORIENT_EXP[0] + 1, ORIENT_EXP[1] - 1))
+@given(
+    lattice_point(),
+    lattice_point(),
+    lattice_point(),
+    st.integers(ORIENT_EXP[0] + 1, ORIENT_EXP[1] - 1),
+)
 def test_orient_tiny_lattice_scaled_to_range_ends(a, b, c, e):
     # Scaling by 2^e is exact, keeps the sign, and moves the configuration
     # anywhere in the documented range (lattice coordinates are in [0.49, 0.51]).
@@ -277,8 +292,13 @@ def test_orient_tiny_lattice_scaled_to_range_ends(a, b, c, e):
 
 
 @PROFILE
-@given(lattice_point(), lattice_point(), lattice_point(), lattice_point(),
-       st.integers(INCIRCLE_EXP[0] + 1, INCIRCLE_EXP[1] - 1))
+@given(
+    lattice_point(),
+    lattice_point(),
+    lattice_point(),
+    lattice_point(),
+    st.integers(INCIRCLE_EXP[0] + 1, INCIRCLE_EXP[1] - 1),
+)
 def test_incircle_tiny_lattice_scaled_to_range_ends(a, b, c, d, e):
     s = 2.0**e
     check_incircle(*[(x * s, y * s) for x, y in (a, b, c, d)])
@@ -287,6 +307,7 @@ def test_incircle_tiny_lattice_scaled_to_range_ends(a, b, c, d, e):
 # ---------------------------------------------------------------------------
 # Nearly collinear / nearly cocircular
 # ---------------------------------------------------------------------------
+
 
 @PROFILE
 @given(near_collinear(points_of(moderate)))
@@ -303,8 +324,11 @@ def test_orient_nearly_collinear_unit(abc):
 
 
 @PROFILE
-@given(near_cocircular(st.floats(min_value=-100.0, max_value=100.0),
-                       st.floats(min_value=1e-3, max_value=1e3)))
+@given(
+    near_cocircular(
+        st.floats(min_value=-100.0, max_value=100.0), st.floats(min_value=1e-3, max_value=1e3)
+    )
+)
 def test_incircle_nearly_cocircular(pts):
     assume(in_range(flat(pts), INCIRCLE_EXP))
     check_incircle(*pts)
@@ -320,6 +344,7 @@ def test_incircle_nearly_cocircular_unit_circle(pts):
 # ---------------------------------------------------------------------------
 # Coordinates around 1e7 with 1e-9 detail
 # ---------------------------------------------------------------------------
+
 
 @PROFILE
 @given(near_1e7_point(), near_1e7_point(), near_1e7_point())
@@ -340,8 +365,12 @@ def test_incircle_near_1e7(a, b, c, d):
 
 
 @PROFILE
-@given(near_cocircular(st.floats(min_value=1e7 - 1.0, max_value=1e7 + 1.0),
-                       st.floats(min_value=1e-6, max_value=1e-2)))
+@given(
+    near_cocircular(
+        st.floats(min_value=1e7 - 1.0, max_value=1e7 + 1.0),
+        st.floats(min_value=1e-6, max_value=1e-2),
+    )
+)
 def test_incircle_nearly_cocircular_near_1e7(pts):
     check_incircle(*pts)
 
@@ -349,6 +378,7 @@ def test_incircle_nearly_cocircular_near_1e7(pts):
 # ---------------------------------------------------------------------------
 # Symmetries (also checked, over all permutations, inside every check_*)
 # ---------------------------------------------------------------------------
+
 
 @PROFILE
 @given(lattice_point(), lattice_point(), lattice_point(), lattice_point())
@@ -369,19 +399,45 @@ def test_swapping_two_points_flips_sign(a, b, c, d):
 # ---------------------------------------------------------------------------
 
 # Integer points on x^2 + y^2 = 25 and x^2 + y^2 = 65^2.
-CIRCLE_5 = sorted({(sx * x, sy * y) for x, y in [(5, 0), (0, 5), (3, 4), (4, 3)]
-                   for sx in (1, -1) for sy in (1, -1)})
-CIRCLE_65 = sorted({(sx * x, sy * y)
-                    for x, y in [(65, 0), (0, 65), (16, 63), (63, 16), (25, 60),
-                                 (60, 25), (33, 56), (56, 33), (39, 52), (52, 39)]
-                    for sx in (1, -1) for sy in (1, -1)})
+CIRCLE_5 = sorted(
+    {
+        (sx * x, sy * y)
+        for x, y in [(5, 0), (0, 5), (3, 4), (4, 3)]
+        for sx in (1, -1)
+        for sy in (1, -1)
+    }
+)
+CIRCLE_65 = sorted(
+    {
+        (sx * x, sy * y)
+        for x, y in [
+            (65, 0),
+            (0, 65),
+            (16, 63),
+            (63, 16),
+            (25, 60),
+            (60, 25),
+            (33, 56),
+            (56, 33),
+            (39, 52),
+            (52, 39),
+        ]
+        for sx in (1, -1)
+        for sy in (1, -1)
+    }
+)
 
 
 @PROFILE
-@given(st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
-       st.integers(-1000, 1000), st.integers(-1000, 1000),
-       st.integers(-1000, 1000), st.integers(-1000, 1000),
-       st.integers(-60, 60))
+@given(
+    st.integers(-(10**6), 10**6),
+    st.integers(-(10**6), 10**6),
+    st.integers(-1000, 1000),
+    st.integers(-1000, 1000),
+    st.integers(-1000, 1000),
+    st.integers(-1000, 1000),
+    st.integers(-60, 60),
+)
 def test_orient_exactly_collinear_lattice(x0, y0, vx, vy, m, n, e):
     s = 2.0**e
     a = (x0 * s, y0 * s)
@@ -391,10 +447,14 @@ def test_orient_exactly_collinear_lattice(x0, y0, vx, vy, m, n, e):
 
 
 @PROFILE
-@given(st.sampled_from([CIRCLE_5, CIRCLE_65]).flatmap(
-           lambda pts: st.permutations(pts).map(lambda p: p[:4])),
-       st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
-       st.integers(-60, 60))
+@given(
+    st.sampled_from([CIRCLE_5, CIRCLE_65]).flatmap(
+        lambda pts: st.permutations(pts).map(lambda p: p[:4])
+    ),
+    st.integers(-(10**6), 10**6),
+    st.integers(-(10**6), 10**6),
+    st.integers(-60, 60),
+)
 def test_incircle_exactly_cocircular_integers(pts, ox, oy, e):
     s = 2.0**e
     moved = [((x + ox) * s, (y + oy) * s) for x, y in pts]
@@ -405,7 +465,7 @@ def test_cocircular_and_collinear_examples():
     assert py_incircle(5, 0, 0, 5, -5, 0, 3, 4) == 0
     assert py_incircle(5, 0, 0, 5, -5, 0, 3, 3.99) == 1
     assert py_incircle(5, 0, 0, 5, -5, 0, 3, 4.01) == -1
-    assert py_incircle(0, 5, 5, 0, -5, 0, 0, 0) == -1      # clockwise a, b, c
+    assert py_incircle(0, 5, 5, 0, -5, 0, 0, 0) == -1  # clockwise a, b, c
     assert py_orient2d(0, 0, 1, 0, 0, 1) == 1
     assert py_orient2d(0, 0, 0, 1, 1, 0) == -1
     assert py_orient2d(-3, 7, 1, 7, 100, 7) == 0
@@ -420,6 +480,7 @@ def test_cocircular_and_collinear_examples():
 # ---------------------------------------------------------------------------
 # The exact stage is really needed and really used
 # ---------------------------------------------------------------------------
+
 
 def test_orient_fallback_on_classic_failure_grid():
     # Points just off (0.5, 0.5) against the line through (12, 12), (24, 24):
@@ -517,8 +578,10 @@ def equilateral_hexagon(draw):
     h = draw(st.floats(1e-4, 0.05))
     t0 = draw(st.floats(0.0, math.pi))
     ks = draw(st.permutations(range(6)))[:4]
-    return [(cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
-            for k in ks]
+    return [
+        (cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
+        for k in ks
+    ]
 
 
 @st.composite
@@ -536,8 +599,10 @@ def lattice_hexagon(draw):
     j = draw(st.integers(1, 8))
     nb = [(i + 1, j), (i, j + 1), (i - 1, j + 1), (i - 1, j), (i, j - 1), (i + 1, j - 1)]
     ks = draw(st.permutations(range(6)))[:4]
-    return [(ox + nb[k][0] * e1[0] + nb[k][1] * e2[0], oy + nb[k][0] * e1[1] + nb[k][1] * e2[1])
-            for k in ks]
+    return [
+        (ox + nb[k][0] * e1[0] + nb[k][1] * e2[0], oy + nb[k][0] * e1[1] + nb[k][1] * e2[1])
+        for k in ks
+    ]
 
 
 @st.composite
@@ -550,8 +615,12 @@ def small_circle(draw):
     pts = []
     for _ in range(4):
         theta = draw(st.floats(0.0, 2 * math.pi))
-        pts.append((nudge(cx + r * math.cos(theta), draw(ulps)),
-                    nudge(cy + r * math.sin(theta), draw(ulps))))
+        pts.append(
+            (
+                nudge(cx + r * math.cos(theta), draw(ulps)),
+                nudge(cy + r * math.sin(theta), draw(ulps)),
+            )
+        )
     return pts
 
 
@@ -582,10 +651,14 @@ def test_stage_b_hexagon_scaled_to_range_ends(pts, e):
 
 
 @PROFILE
-@given(st.sampled_from([CIRCLE_5, CIRCLE_65]).flatmap(
-           lambda pts: st.permutations(pts).map(lambda p: p[:4])),
-       st.integers(-10**6, 10**6), st.integers(-10**6, 10**6),
-       st.integers(-120, 120))
+@given(
+    st.sampled_from([CIRCLE_5, CIRCLE_65]).flatmap(
+        lambda pts: st.permutations(pts).map(lambda p: p[:4])
+    ),
+    st.integers(-(10**6), 10**6),
+    st.integers(-(10**6), 10**6),
+    st.integers(-120, 120),
+)
 def test_stage_b_integer_circles_scaled(pts, ox, oy, e):
     # Exactly cocircular; the differences (x - x') * 2^e are exact.
     s = 2.0**e
@@ -594,8 +667,14 @@ def test_stage_b_integer_circles_scaled(pts, ox, oy, e):
 
 
 @PROFILE
-@given(st.floats(0.25, 0.5), st.floats(0.25, 0.5), st.floats(0.5, 1.0), st.floats(0.5, 1.0),
-       st.permutations(range(4)), st.integers(-150, 200))
+@given(
+    st.floats(0.25, 0.5),
+    st.floats(0.25, 0.5),
+    st.floats(0.5, 1.0),
+    st.floats(0.5, 1.0),
+    st.permutations(range(4)),
+    st.integers(-150, 200),
+)
 def test_stage_b_rectangles(x1, x2, y1, y2, order, e):
     # Corners of an axis-aligned rectangle are exactly cocircular, whatever
     # the doubles; full-width coordinates make the zero hard to see (several
@@ -608,10 +687,12 @@ def test_stage_b_rectangles(x1, x2, y1, y2, order, e):
 def test_stage_b_pinned_grown_path():
     # A scaled rectangle whose zero determinant the certificate does not see
     # within the sweeps: decided by growing the components.
-    pts = [(-6.479526483929613e-14, -1.901272885017952e-15),
-           (-2.4760177410006713e-14, -4.019328122107341e-14),
-           (-6.479526483929613e-14, -4.019328122107341e-14),
-           (-2.4760177410006713e-14, -1.901272885017952e-15)]
+    pts = [
+        (-6.479526483929613e-14, -1.901272885017952e-15),
+        (-2.4760177410006713e-14, -4.019328122107341e-14),
+        (-6.479526483929613e-14, -4.019328122107341e-14),
+        (-2.4760177410006713e-14, -1.901272885017952e-15),
+    ]
     assert _kernel._pred_py_incircle_stage_b_path(*flat(pts)) == (0, "grown")
     assert check_incircle_stage_b(pts) == 0
 
@@ -625,8 +706,10 @@ def test_stage_b_decides_the_lattice_cases_the_filter_leaves():
         cx, cy = rng.uniform(0.26, 0.45), rng.uniform(0.55, 0.95)
         h, t0 = rng.uniform(1e-3, 0.02), rng.uniform(0, math.pi)
         ks = rng.sample(range(6), 4)
-        pts = [(cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
-               for k in ks]
+        pts = [
+            (cx + h * math.cos(t0 + k * math.pi / 3), cy + h * math.sin(t0 + k * math.pi / 3))
+            for k in ks
+        ]
         filt, _ = _kernel._pred_py_incircle_stages(*flat(pts))
         if filt is None:
             undecided += 1
@@ -638,9 +721,14 @@ def test_stage_b_decides_the_lattice_cases_the_filter_leaves():
 # Inexact differences: incircle's stage B decides with the tail bound (T) or
 # abstains; stage C decides.
 
+
 @PROFILE
-@given(points_of(coords((-80, -60))), points_of(coords((-2, 2))),
-       points_of(coords((-80, -60))), points_of(coords((-2, 2))))
+@given(
+    points_of(coords((-80, -60))),
+    points_of(coords((-2, 2))),
+    points_of(coords((-80, -60))),
+    points_of(coords((-2, 2))),
+)
 def test_stage_b_inexact_differences(a, b, c, d):
     # Coordinates near 1 against coordinates near 1e-20: a difference like
     # 1.0 - 1e-20 is not a double.  check_incircle / check_orient assert
@@ -648,7 +736,10 @@ def test_stage_b_inexact_differences(a, b, c, d):
     assume(not differences_exact((a, b, c, d)))
     check_incircle(a, b, c, d)
     assert _kernel._pred_py_incircle_stage_b_path(*flat((a, b, c, d)))[1] in (
-        "tails", "inexact", "split")
+        "tails",
+        "inexact",
+        "split",
+    )
     check_orient(d, a, b)
     check_orient(a, c, d)
 
@@ -697,12 +788,29 @@ def test_stage_b_tails_decide_large_configurations():
 
 def test_stage_b_tails_pinned_mesh_inputs():
     # Met in a mesh of the unit square (h = 0.0025), left by the filter.
-    for r in ([0.1825, 0.0, 0.00216506350946108, 0.15375, 0.15375, 0.0021650635094610958,
-               0.0, 0.1825],
-              [0.002165063509461112, 0.38125, 0.38625, 0.0021650635094610958,
-               0.002165063509461112, 0.38625, 0.38125, 0.0021650635094610958],
-              [0.31875, 0.9978349364905389, 0.002165063509461112, 0.70875,
-               0.00216506350946108, 0.6812499999999999, 0.29125, 0.9978349364905389]):
+    for r in (
+        [0.1825, 0.0, 0.00216506350946108, 0.15375, 0.15375, 0.0021650635094610958, 0.0, 0.1825],
+        [
+            0.002165063509461112,
+            0.38125,
+            0.38625,
+            0.0021650635094610958,
+            0.002165063509461112,
+            0.38625,
+            0.38125,
+            0.0021650635094610958,
+        ],
+        [
+            0.31875,
+            0.9978349364905389,
+            0.002165063509461112,
+            0.70875,
+            0.00216506350946108,
+            0.6812499999999999,
+            0.29125,
+            0.9978349364905389,
+        ],
+    ):
         pts = [(r[2 * i], r[2 * i + 1]) for i in range(4)]
         assert _kernel._pred_py_incircle_stages(*r)[0] is None
         assert _kernel._pred_py_incircle_stage_b_path(*r) == (incircle_oracle(*pts), "tails")
@@ -710,8 +818,13 @@ def test_stage_b_tails_pinned_mesh_inputs():
 
 
 @PROFILE
-@given(st.floats(-0.5, -0.25), st.floats(0.25, 1.0), st.floats(-0.5, -0.25), st.floats(0.25, 1.0),
-       st.permutations(range(4)))
+@given(
+    st.floats(-0.5, -0.25),
+    st.floats(0.25, 1.0),
+    st.floats(-0.5, -0.25),
+    st.floats(0.25, 1.0),
+    st.permutations(range(4)),
+)
 def test_stage_b_inexact_differences_zero_determinant(x1, x2, y1, y2, order):
     # A rectangle straddling both axes: exactly cocircular, differences
     # mostly inexact.  No bound can show a zero: stage B must abstain (or,
@@ -730,16 +843,24 @@ def test_stage_b_near_origin_all_paths_agree():
     inexact = 0
     for _ in range(400):
         r = rng.uniform(1e-3, 1.0)
-        pts = [(r * math.cos(t), r * math.sin(t))
-               for t in (rng.uniform(0, 2 * math.pi) for _ in range(4))]
+        pts = [
+            (r * math.cos(t), r * math.sin(t))
+            for t in (rng.uniform(0, 2 * math.pi) for _ in range(4))
+        ]
         check_incircle(*pts)
         inexact += not differences_exact(pts)
     assert inexact > 100
 
 
 @PROFILE
-@given(st.floats(0.5, 1.0), st.floats(0.5, 1.0), st.floats(0.5, 1.0), st.floats(0.5, 1.0),
-       st.integers(-140, -100), points_of(coords((-10, 10))))
+@given(
+    st.floats(0.5, 1.0),
+    st.floats(0.5, 1.0),
+    st.floats(0.5, 1.0),
+    st.floats(0.5, 1.0),
+    st.integers(-140, -100),
+    points_of(coords((-10, 10))),
+)
 def test_stage_b_split_abstains(x1, y1, x2, y2, e, a):
     # d at the origin makes every difference exact, but a minor
     # bdx*cdy - cdx*bdy with bdx, cdy ~ 1 and cdx, bdy ~ 2^e spans far more
@@ -751,13 +872,18 @@ def test_stage_b_split_abstains(x1, y1, x2, y2, e, a):
 
 
 def test_stage_b_split_example():
-    pts = [(0.75, 0.3), (0.7654321, 0.8765432 * 2.0**-120), (0.6789012 * 2.0**-120, 0.5432109),
-           (0.0, 0.0)]
+    pts = [
+        (0.75, 0.3),
+        (0.7654321, 0.8765432 * 2.0**-120),
+        (0.6789012 * 2.0**-120, 0.5432109),
+        (0.0, 0.0),
+    ]
     assert _kernel._pred_py_incircle_stage_b_path(*flat(pts)) == (None, "split")
     check_incircle(*pts)
 
 
 # orient2d's stage B.
+
 
 @PROFILE
 @given(near_collinear(points_of(st.floats(min_value=0.26, max_value=0.49))))
@@ -771,13 +897,15 @@ def test_orient_stage_b_nearly_collinear(abc):
 
 # The sign readers of stage B on their own.
 
+
 @st.composite
 def cancelling_doubles(draw):
     """Up to 54 doubles of very different magnitudes whose sum nearly cancels:
     random values, some repeated with the opposite sign and moved by ulps."""
     base = draw(st.lists(st.floats(min_value=0.5, max_value=1.0), min_size=1, max_size=20))
-    vals = [draw(st.sampled_from([1.0, -1.0])) * v * 2.0**draw(st.integers(-200, 200))
-            for v in base]
+    vals = [
+        draw(st.sampled_from([1.0, -1.0])) * v * 2.0 ** draw(st.integers(-200, 200)) for v in base
+    ]
     back = draw(st.lists(st.sampled_from(range(len(vals))), max_size=27))
     vals += [nudge(-vals[i], draw(st.integers(-2, 2))) for i in back]
     vals = vals[:54]
@@ -789,7 +917,7 @@ def cancelling_doubles(draw):
 def test_stage_b_sign_readers(vals, sweeps):
     exact = sum(Fraction(v) for v in vals)
     cert, swept, grown = _kernel._pred_py_sum_sign(vals, sweeps)
-    assert sum(Fraction(v) for v in swept) == exact      # sweeps keep the sum
+    assert sum(Fraction(v) for v in swept) == exact  # sweeps keep the sum
     assert cert in (None, sign(exact)), (vals, cert)
     assert grown == sign(exact), (vals, grown)
 

@@ -6,6 +6,7 @@ asserts the right behaviour, so it fails until the bug is fixed.  Calls that hun
 could exhaust memory run in a forked child with a time and memory limit
 (``fuzz_domains.isolated``), so a regression fails its test instead of the run.
 """
+
 from __future__ import annotations
 
 import os
@@ -13,15 +14,19 @@ import signal
 import threading
 import time
 
+import fuzz_domains as fd
 import numpy as np
 import pytest
 from shapely.geometry import GeometryCollection, LineString, Point, Polygon, box
 
 import aftmesh
-from aftmesh import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
-                     InvalidOptionError, InvalidSizeError)
-
-import fuzz_domains as fd
+from aftmesh import (
+    CrossingSegmentsError,
+    InvalidDomainError,
+    InvalidInputError,
+    InvalidOptionError,
+    InvalidSizeError,
+)
 
 SQ = box(0, 0, 1, 1)
 
@@ -74,9 +79,18 @@ def test_short_edge_next_to_long_edges_keeps_boundary_graded(checked):
 
 def test_slot_a_few_nanometres_wide_is_meshed(checked):
     """The fuzzer's original: a slot 1.7e-9 wide cut into the unit square, no size."""
-    poly = Polygon([(0, 0), (1, 0), (1, 1), (0.7239563302418025, 1),
-                    (0.7239563302418025, 0.75), (0.7239563285035484, 0.75),
-                    (0.7239563285035484, 1), (0, 1)])
+    poly = Polygon(
+        [
+            (0, 0),
+            (1, 0),
+            (1, 1),
+            (0.7239563302418025, 1),
+            (0.7239563302418025, 0.75),
+            (0.7239563285035484, 0.75),
+            (0.7239563285035484, 1),
+            (0, 1),
+        ]
+    )
     mesh = _in_child(aftmesh.generate, poly, timeout=30)
     checked(mesh, domain_area=fd.exact_area([poly]))
 
@@ -150,7 +164,7 @@ def test_max_triangles_beyond_int64_is_no_cap_or_refused(checked):
     """max_triangles=2**70: OverflowError converting to a C long long; a cap above
     any possible mesh is no cap (or an InvalidOptionError)."""
     try:
-        mesh = aftmesh.generate(SQ, 0.1, max_triangles=2 ** 70)
+        mesh = aftmesh.generate(SQ, 0.1, max_triangles=2**70)
     except InvalidOptionError:
         return
     checked(mesh, domain_area=1.0)
@@ -159,7 +173,7 @@ def test_max_triangles_beyond_int64_is_no_cap_or_refused(checked):
 def test_smooth_beyond_int_range_is_capped_or_refused(checked):
     """smooth=2**40: OverflowError 'value too large to convert to int'."""
     try:
-        mesh = _in_child(aftmesh.generate, SQ, 0.1, smooth=2 ** 40, timeout=20)
+        mesh = _in_child(aftmesh.generate, SQ, 0.1, smooth=2**40, timeout=20)
     except InvalidOptionError:
         return
     checked(mesh, domain_area=1.0)
@@ -170,7 +184,7 @@ def test_smooth_many_rounds_stops_when_nothing_moves(checked):
     moves nothing) inside one nogil call that never checks for Ctrl-C: an
     uninterruptible hang."""
     try:
-        mesh = _in_child(aftmesh.generate, SQ, 0.1, smooth=10 ** 9, timeout=20)
+        mesh = _in_child(aftmesh.generate, SQ, 0.1, smooth=10**9, timeout=20)
     except InvalidOptionError:
         return
     checked(mesh, domain_area=1.0)
@@ -181,6 +195,7 @@ def test_ctrl_c_during_smoothing_interrupts(time_limit):
     smoothing returns: with smooth=10**6 never.  It should stop within a second.
     (smooth is now capped at 1000 rounds and stops when a round moves nothing; the
     test uses the cap.)"""
+
     def run():
         state = {}
         signal.signal(signal.SIGINT, signal.default_int_handler)  # even if inherited ignored
@@ -194,6 +209,7 @@ def test_ctrl_c_during_smoothing_interrupts(time_limit):
             if f > 0.95 and "armed" not in state:
                 state["armed"] = True
                 threading.Thread(target=fire, daemon=True).start()
+
         try:
             aftmesh.generate(SQ, 0.002, smooth=1000, progress=progress)
         except KeyboardInterrupt:
@@ -213,17 +229,19 @@ def test_signal_handler_exception_propagates_from_the_loop():
     pytest-timeout and many watchdogs work) surfaces as KeyboardInterrupt: the loop
     clears the pending exception after PyErr_CheckSignals and returns
     ERR_INTERRUPTED.  The handler's exception should propagate."""
+
     class Watchdog(Exception):
         pass
 
     def run():
         def handler(sig, frame):
             raise Watchdog("time is up")
+
         signal.signal(signal.SIGALRM, handler)
         signal.setitimer(signal.ITIMER_REAL, 0.5)
         try:
             aftmesh.generate(SQ, 0.001)
-        except BaseException as exc:          # noqa: BLE001
+        except BaseException as exc:  # noqa: BLE001
             return type(exc).__name__
         finally:
             signal.setitimer(signal.ITIMER_REAL, 0)
@@ -239,8 +257,13 @@ def test_crossing_constraint_lines_are_noded(checked):
     (orient2d == 0), which a rounded crossing point almost never is, so the lines
     still cross: CrossingSegmentsError between 'constraint line 1' and 'constraint
     line 0' (with size None or 0.1; size 0.3 happens to work)."""
-    gc = GeometryCollection([box(0, 0, 2, 1), LineString([(0.2, 0.2), (1.8, 0.8)]),
-                             LineString([(0.2, 0.8), (1.8, 0.2)])])
+    gc = GeometryCollection(
+        [
+            box(0, 0, 2, 1),
+            LineString([(0.2, 0.2), (1.8, 0.8)]),
+            LineString([(0.2, 0.8), (1.8, 0.2)]),
+        ]
+    )
     for size in (None, 0.1):
         mesh = aftmesh.generate(gc, size)
         checked(mesh, domain_area=2.0)
@@ -248,10 +271,12 @@ def test_crossing_constraint_lines_are_noded(checked):
 
 def test_crossing_constraint_lines_in_a_triangle_are_noded(checked):
     """The example hypothesis shrank to: a triangle with two crossing lines."""
-    tri = Polygon([(-0.5, 0.8660254037844387), (-0.5, -0.8660254037844385),
-                   (1.0, -2.4492935982947064e-16)])
-    gc = GeometryCollection([tri, LineString([(0.5, -0.25), (0, 0.5)]),
-                             LineString([(0.5, 0), (0, 0)])])
+    tri = Polygon(
+        [(-0.5, 0.8660254037844387), (-0.5, -0.8660254037844385), (1.0, -2.4492935982947064e-16)]
+    )
+    gc = GeometryCollection(
+        [tri, LineString([(0.5, -0.25), (0, 0.5)]), LineString([(0.5, 0), (0, 0)])]
+    )
     mesh = aftmesh.generate(gc, 0.5728219618694801)
     checked(mesh, domain_area=fd.exact_area([tri]))
 
@@ -261,8 +286,10 @@ def test_dict_crossing_segments_refused_whatever_the_size():
     0.2, 0.3 or 0.5, but a mesh with size 0.1, where both diagonals happen to be cut
     at their midpoint (0.5, 0.5).  The policy (pslg.py) is to refuse crossing
     segments, whatever the size."""
-    d = {"vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
-         "segments": [(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)]}
+    d = {
+        "vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
+        "segments": [(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)],
+    }
     with pytest.raises(CrossingSegmentsError):
         aftmesh.generate(d, 0.3)
     with pytest.raises(CrossingSegmentsError):
@@ -279,21 +306,27 @@ def test_region_ring_too_short_names_the_region():
 def test_segment_markers_beyond_int32_kept_or_refused():
     """segment_markers=[2**40, 2, 3]: cast to int32 without a check, so the first
     segment's marker silently becomes 0."""
-    d = {"vertices": [(0, 0), (1, 0), (0, 1)], "segments": [(0, 1), (1, 2), (2, 0)],
-         "segment_markers": [2 ** 40, 2, 3]}
+    d = {
+        "vertices": [(0, 0), (1, 0), (0, 1)],
+        "segments": [(0, 1), (1, 2), (2, 0)],
+        "segment_markers": [2**40, 2, 3],
+    }
     try:
         mesh = aftmesh.generate(d, 0.5)
     except InvalidInputError:
         return
-    assert 2 ** 40 in set(np.asarray(mesh.segment_markers).tolist())
+    assert 2**40 in set(np.asarray(mesh.segment_markers).tolist())
 
 
 def test_dict_segment_markers_ragged_refused_by_name():
     """segment_markers=[None, [[0.0]]]: numpy's bare ValueError 'setting an array
     element with a sequence ... inhomogeneous shape' from np.asarray in _from_dict,
     not an InvalidInputError naming segment_markers (found by the garbage fuzzer)."""
-    d = {"vertices": [(0, 0), (1, 0), (0, 1)], "segments": [(0, 1), (1, 2), (2, 0)],
-         "segment_markers": [None, np.array([[0.0]]), 1]}
+    d = {
+        "vertices": [(0, 0), (1, 0), (0, 1)],
+        "segments": [(0, 1), (1, 2), (2, 0)],
+        "segment_markers": [None, np.array([[0.0]]), 1],
+    }
     with pytest.raises(InvalidInputError, match="segment_markers"):
         aftmesh.generate(d, 0.5)
 
@@ -305,12 +338,18 @@ def test_check_mesh_reports_stale_neighbors():
     instead of a MeshCheckError listing the problems (found by the oracle's
     self-test)."""
     from aftmesh.checks import MeshCheckError, check_mesh
+
     good = aftmesh.generate(SQ, 0.25)
     T = np.asarray(good.triangles)[1:]
     N = np.asarray(good.neighbors)[1:]
     assert N.max() == len(T)
-    broken = aftmesh.Mesh(points=good.points, triangles=T, neighbors=N,
-                          segments=good.segments, regions=np.zeros(len(T), dtype=np.int32))
+    broken = aftmesh.Mesh(
+        points=good.points,
+        triangles=T,
+        neighbors=N,
+        segments=good.segments,
+        regions=np.zeros(len(T), dtype=np.int32),
+    )
     with pytest.raises(MeshCheckError):
         check_mesh(broken, domain_area=1.0)
 
@@ -361,8 +400,11 @@ def test_dict_regions_scalar_refused_by_name(regions):
     type 'bool' has no len()" from `len(regions)` in _from_dict; cdt() with the same
     regions says 'regions must be rows of (x, y, marker)' (found by the garbage fuzzer,
     long profile)."""
-    d = {"vertices": [(0, 0), (1, 0), (0, 1)], "segments": [(0, 1), (1, 2), (2, 0)],
-         "regions": regions}
+    d = {
+        "vertices": [(0, 0), (1, 0), (0, 1)],
+        "segments": [(0, 1), (1, 2), (2, 0)],
+        "regions": regions,
+    }
     with pytest.raises(InvalidInputError, match="regions"):
         aftmesh.generate(d, 0.5)
 
@@ -403,12 +445,17 @@ def test_constraint_ending_on_edge_far_from_origin(t, checked):
     a, b = ring[11], ring[0]
     end = a + t * (b - a)
     poly = Polygon(ring + off)
-    gc = GeometryCollection([poly, LineString([tuple(np.array([0.1, 0.05]) + off),
-                                               tuple(end + off)])])
+    gc = GeometryCollection(
+        [poly, LineString([tuple(np.array([0.1, 0.05]) + off), tuple(end + off)])]
+    )
     mesh = aftmesh.generate(gc, 0.2)
-    checked(mesh, domain_area=fd.exact_area([poly]),
-            area_rtol=fd.area_tolerance(fd.FuzzCase("12-gon", poly, 0.2, {}, [poly]),
-                                        fd.exact_area([poly])))
+    checked(
+        mesh,
+        domain_area=fd.exact_area([poly]),
+        area_rtol=fd.area_tolerance(
+            fd.FuzzCase("12-gon", poly, 0.2, {}, [poly]), fd.exact_area([poly])
+        ),
+    )
 
 
 @pytest.mark.parametrize("size", [5e-9, 1e-9])
@@ -426,9 +473,11 @@ def test_size_below_coordinate_resolution_zero_length_segments(size, checked):
     except InvalidSizeError as exc:
         assert "segments[" not in str(exc), str(exc)
         return
-    checked(mesh, domain_area=fd.exact_area([sq]),
-            area_rtol=fd.area_tolerance(fd.FuzzCase("sq", sq, size, {}, [sq]),
-                                        fd.exact_area([sq])))
+    checked(
+        mesh,
+        domain_area=fd.exact_area([sq]),
+        area_rtol=fd.area_tolerance(fd.FuzzCase("sq", sq, size, {}, [sq]), fd.exact_area([sq])),
+    )
 
 
 def test_grazing_constraint_pieces_cross_after_discretization(checked):
@@ -456,14 +505,17 @@ def test_constraint_ending_an_ulp_outside_the_boundary(checked):
     that thin back onto the polygon) refused this one as 'constraint line 0 is not
     inside the domain'.  Now the outside part's ends and middle must lie within the
     snapping tolerance of the domain.  Found by the fuzzer (constraints)."""
-    poly = Polygon([(-0.6541631149290893, 0.618118612457408),
-                    (0.46312640783270953, -0.796575090255773),
-                    (0.9924533439941903, -2.4308096220511445e-16)])
+    poly = Polygon(
+        [
+            (-0.6541631149290893, 0.618118612457408),
+            (0.46312640783270953, -0.796575090255773),
+            (0.9924533439941903, -2.4308096220511445e-16),
+        ]
+    )
     end = (-0.4895014690367614, 0.5563067512116672)
     assert not poly.covers(Point(end))
     line = LineString([(0.6264150616181526, 0.0), end])
-    mesh = checked(aftmesh.generate(GeometryCollection([poly, line]), 0.35),
-                   domain_area=poly.area)
+    mesh = checked(aftmesh.generate(GeometryCollection([poly, line]), 0.35), domain_area=poly.area)
     assert end in set(map(tuple, np.asarray(mesh.points).tolist()))
     # a line that really leaves the domain is still refused
     with pytest.raises(InvalidDomainError, match="constraint line 0"):
@@ -477,15 +529,23 @@ def test_needle_an_ulp_wide_is_not_folded_by_snapping(checked):
     its tip ('input corner (1.229e-07, 1e-06) is not a mesh vertex').  A vertex joined
     by a segment to an end of the segment is not snapped onto it.  Found by the fuzzer
     (walk+small, split_boundary=False)."""
-    ring = [(4.314853096290475e-7, 8.461878383307198e-7), (7.891278723393342e-7, 8.99208396012279e-7),
-            (8.808360498265026e-7, 5.923608809873998e-7), (0.0, 3.778579095052713e-7),
-            (1.544068913417336e-7, 9.999999999999997e-7), (1.229362482212402e-7, 1e-6),
-            (9.508644384332265e-7, 9.999999999999997e-7)]
+    ring = [
+        (4.314853096290475e-7, 8.461878383307198e-7),
+        (7.891278723393342e-7, 8.99208396012279e-7),
+        (8.808360498265026e-7, 5.923608809873998e-7),
+        (0.0, 3.778579095052713e-7),
+        (1.544068913417336e-7, 9.999999999999997e-7),
+        (1.229362482212402e-7, 1e-6),
+        (9.508644384332265e-7, 9.999999999999997e-7),
+    ]
     poly = Polygon(ring)
     assert poly.is_valid
     for split in (False, True):
-        mesh = checked(aftmesh.generate(poly, 4.5452462393882883e-07, split_boundary=split),
-                       domain_area=poly.area, area_rtol=1e-9)
+        mesh = checked(
+            aftmesh.generate(poly, 4.5452462393882883e-07, split_boundary=split),
+            domain_area=poly.area,
+            area_rtol=1e-9,
+        )
         assert (1.229362482212402e-7, 1e-6) in set(map(tuple, np.asarray(mesh.points).tolist()))
 
 
@@ -496,13 +556,23 @@ def test_gap_of_a_few_ulps_far_from_origin_is_not_closed(checked):
     2.98e-08 away from every input edge'); the tolerance is now 2 ulps, the rounding of
     a computed point.  Found by the fuzzer (walk+offset)."""
     # the fuzzer's 11-vertex polygon, cut down to the vertices that keep the failure
-    ring = [[71066330.76221266, -71066330.08782011], [71066331.68696073, -71066330.26221254],
-            [71066330.92969792, -71066330.26221254], [71066330.87220481, -71066330.12522256],
-            [71066330.7622126, -71066330.61966804], [71066331.46262462, -71066330.76221243],
-            [71066330.76221254, -71066330.76221254]]
+    ring = [
+        [71066330.76221266, -71066330.08782011],
+        [71066331.68696073, -71066330.26221254],
+        [71066330.92969792, -71066330.26221254],
+        [71066330.87220481, -71066330.12522256],
+        [71066330.7622126, -71066330.61966804],
+        [71066331.46262462, -71066330.76221243],
+        [71066330.76221254, -71066330.76221254],
+    ]
     poly = Polygon(ring)
-    case = fd.FuzzCase("walk+offset", np.array(ring), None,
-                       {"smooth": 0, "close_factor": 1.0, "gradation": 2.0}, [poly])
+    case = fd.FuzzCase(
+        "walk+offset",
+        np.array(ring),
+        None,
+        {"smooth": 0, "close_factor": 1.0, "gradation": 2.0},
+        [poly],
+    )
     fd.verify(case.call(), case, check=checked)
 
 
@@ -513,18 +583,30 @@ def test_crossing_points_closer_than_a_dot_products_ulp_ordered_exactly(checked)
     crossed again after every round of noding, and generate raised
     CrossingSegmentsError naming constraint lines 1 and 0.  The points are now ordered
     by their coordinates.  Found by the fuzzer (constraints)."""
-    poly = Polygon([(-0.07021862439709335, 0.2916664958266203),
-                    (-0.27763851442294835, 0.1136523440542178),
-                    (-0.2545812678208489, -0.1587084688185517),
-                    (-0.0010009756642637793, -0.29999833007488486),
-                    (0.3, -7.347880794884119e-17)])
-    lines = [LineString([(-0.18362673833910703, 0.0), (0.0, 0.0), (-6.103515625e-05, -0.22903685508655236)]),
-             LineString([(-1e-12, 0.01), (0.0, -0.01595904312880836)]),
-             LineString([(0.0, 0.0), (0.14995309559710446, 0.0), (0.0, 0.04)]),
-             LineString([(-0.20199876099902425, 1e-12), (0.0, 0.0)])]
-    points = [Point(-0.02791090438228072, 0.0), Point(-0.14331543830913562, 0.0),
-              Point(-1e-12, -0.14331543830913562), Point(-6.050585107623707e-06, -0.022705061633780332),
-              Point(-0.10099938049951213, 5e-13)]
+    poly = Polygon(
+        [
+            (-0.07021862439709335, 0.2916664958266203),
+            (-0.27763851442294835, 0.1136523440542178),
+            (-0.2545812678208489, -0.1587084688185517),
+            (-0.0010009756642637793, -0.29999833007488486),
+            (0.3, -7.347880794884119e-17),
+        ]
+    )
+    lines = [
+        LineString(
+            [(-0.18362673833910703, 0.0), (0.0, 0.0), (-6.103515625e-05, -0.22903685508655236)]
+        ),
+        LineString([(-1e-12, 0.01), (0.0, -0.01595904312880836)]),
+        LineString([(0.0, 0.0), (0.14995309559710446, 0.0), (0.0, 0.04)]),
+        LineString([(-0.20199876099902425, 1e-12), (0.0, 0.0)]),
+    ]
+    points = [
+        Point(-0.02791090438228072, 0.0),
+        Point(-0.14331543830913562, 0.0),
+        Point(-1e-12, -0.14331543830913562),
+        Point(-6.050585107623707e-06, -0.022705061633780332),
+        Point(-0.10099938049951213, 5e-13),
+    ]
     gc = GeometryCollection([poly, *lines, *points])
     case = fd.FuzzCase("constraints", gc, 0.033075272202751325, {}, [poly], lines, points)
     fd.verify(case.call(), case, check=checked)
@@ -540,8 +622,12 @@ def test_needle_an_ulp_wide_keeps_its_tip_when_split(checked):
     segment.  Found by the fuzzer (walk+small)."""
     # the needle of the fuzzer's 26-vertex polygon, closed by one more vertex
     y = 9.999999999999997e-07
-    ring = [(3.365591503278354e-08, y), (2.8521983272121794e-07, y), (6.103515625e-11, 1e-06),
-            (1e-7, 5e-7)]
+    ring = [
+        (3.365591503278354e-08, y),
+        (2.8521983272121794e-07, y),
+        (6.103515625e-11, 1e-06),
+        (1e-7, 5e-7),
+    ]
     poly = Polygon(ring)
     assert poly.is_valid
     case = fd.FuzzCase("walk+small", poly, 7.024103985267414e-08, {}, [poly])
@@ -554,9 +640,11 @@ def test_dict_segment_through_a_vertex_split_before_discretization(checked):
     """A dict whose segment 0 runs exactly through vertex 4 (the end of segment 4):
     split there before the size splits it, so the rounded split points cannot miss the
     vertex; the pieces keep segment 0's marker."""
-    d = {"vertices": [[0, 0], [3, 1], [0, 2], [-1, 1], [1.5, 0.5], [1.0, 1.0]],
-         "segments": [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5]],
-         "segment_markers": [7, 8, 9, 10, 11]}
+    d = {
+        "vertices": [[0, 0], [3, 1], [0, 2], [-1, 1], [1.5, 0.5], [1.0, 1.0]],
+        "segments": [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5]],
+        "segment_markers": [7, 8, 9, 10, 11],
+    }
     mesh = checked(aftmesh.generate(d, 0.13), domain_area=4.0)
     assert any("split 1 segments at vertices" in c for c in mesh.info["cleanup"])
     P = np.asarray(mesh.points)
@@ -575,13 +663,19 @@ def test_hole_an_ulp_from_the_outer_ring_is_not_snapped_onto_it(checked):
     input edge was no longer a mesh segment.  Only free ends of lines (and lone points)
     are snapped now; a ring's corner stays where it is.  Found by the fuzzer
     (near-hole-to-edge+offset)."""
-    hole = [(10000000.000000002, -9999999.0), (10000000.5, -9999999.05),
-            (10000001.0, -9999999.0), (10000000.5, -9999998.95)]
-    poly = Polygon([(1e7, -1e7), (10000002.0, -1e7), (10000002.0, -9999998.0), (1e7, -9999998.0)],
-                   [hole])
+    hole = [
+        (10000000.000000002, -9999999.0),
+        (10000000.5, -9999999.05),
+        (10000001.0, -9999999.0),
+        (10000000.5, -9999998.95),
+    ]
+    poly = Polygon(
+        [(1e7, -1e7), (10000002.0, -1e7), (10000002.0, -9999998.0), (1e7, -9999998.0)], [hole]
+    )
     for split in (False, True):
-        case = fd.FuzzCase("near-hole-to-edge+offset", poly, 0.385, {"split_boundary": split},
-                           [poly])
+        case = fd.FuzzCase(
+            "near-hole-to-edge+offset", poly, 0.385, {"split_boundary": split}, [poly]
+        )
         mesh = case.call()
         fd.verify(mesh, case, check=checked)
         assert not any("vertices lying on them" in c for c in mesh.info["cleanup"])
@@ -597,8 +691,12 @@ def test_vertex_within_rounding_of_a_piece_keeps_its_side(checked):
     near a segment is on the same side of its pieces as of the segment (exact
     orientation).  Found by the fuzzer (walk)."""
     e = 0.9999999999999999
-    ring = [(0.3691182857977418, e), (0.8963404525622876, 1.0), (0.5, 0.3),
-            (0.48404463285669996, e)]
+    ring = [
+        (0.3691182857977418, e),
+        (0.8963404525622876, 1.0),
+        (0.5, 0.3),
+        (0.48404463285669996, e),
+    ]
     poly = Polygon(ring)
     assert poly.is_valid
     case = fd.FuzzCase("walk", poly, 0.053612085881384566, {}, [poly])
@@ -620,8 +718,9 @@ def test_triangle_one_ulp_squared_far_from_origin_is_meshed(checked):
     poly = Polygon(ring)
     assert poly.is_valid and poly.area > 0
     for split in (True, False):
-        mesh = checked(aftmesh.generate(poly, split_boundary=split), domain_area=poly.area,
-                       area_rtol=1e-12)
+        mesh = checked(
+            aftmesh.generate(poly, split_boundary=split), domain_area=poly.area, area_rtol=1e-12
+        )
         assert len(mesh.triangles) == 1
     # the same through a region list (the region index comes from the same test)
     mesh = checked(aftmesh.generate([poly]), domain_area=poly.area, area_rtol=1e-12)
@@ -655,15 +754,28 @@ def test_two_lines_ending_at_one_point_within_rounding_of_an_edge(checked):
     (CrossingSegmentsError naming constraint line 0 and the exterior ring).  Any
     vertex that is on no polygon ring is snapped now.  Found by the fuzzer
     (constraints)."""
-    poly = Polygon([(0.016514367915341048, 0.04719402136242211),
-                    (-0.026080074013174682, -0.04265946248451018),
-                    (0.9276368212657233, -2.272054927868587e-16)])
+    poly = Polygon(
+        [
+            (0.016514367915341048, 0.04719402136242211),
+            (-0.026080074013174682, -0.04265946248451018),
+            (0.9276368212657233, -2.272054927868587e-16),
+        ]
+    )
     end = (0.012254923722489475, 0.03820867297772888)
     lines = [LineString([(0.032557692705115215, 0.0), end]), LineString([(0.0, 0.0), end])]
-    points = [Point(0.022406308213802344, 0.01910433648886444),
-              Point(0.006127461861244738, 0.01910433648886444)]
-    case = fd.FuzzCase("constraints", GeometryCollection([poly, *lines, *points]),
-                       0.03831761088376678, {}, [poly], lines, points)
+    points = [
+        Point(0.022406308213802344, 0.01910433648886444),
+        Point(0.006127461861244738, 0.01910433648886444),
+    ]
+    case = fd.FuzzCase(
+        "constraints",
+        GeometryCollection([poly, *lines, *points]),
+        0.03831761088376678,
+        {},
+        [poly],
+        lines,
+        points,
+    )
     mesh = case.call()
     fd.verify(mesh, case, check=checked)
     assert end in set(map(tuple, np.asarray(mesh.points).tolist()))
@@ -678,9 +790,10 @@ def test_boundary_edge_lengths_hold_next_to_the_boundary():
     BOUNDARY_REACH edge lengths and grows beyond, so a tiny edge still cannot flood a
     cell."""
     from aftmesh.sizing import BOUNDARY_REACH, make_size_field
+
     bounds = ((0.0, 0.0), (100.0, 100.0))
     f = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([0.5]))
-    assert f.dx > 0.1 and f.dx * np.sqrt(2) < BOUNDARY_REACH * 0.5   # nodes within reach
+    assert f.dx > 0.1 and f.dx * np.sqrt(2) < BOUNDARY_REACH * 0.5  # nodes within reach
     assert f(50.1, 50.1) == pytest.approx(0.5, rel=1e-12)
     tiny = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([1e-6]))
-    assert tiny(50.1, 50.1) > 1e3 * 1e-6          # not spread over the whole cell
+    assert tiny(50.1, 50.1) > 1e3 * 1e-6  # not spread over the whole cell

@@ -18,11 +18,11 @@ leaks").
 
 Failures found here are pinned as named tests in ``test_regressions.py``.
 """
+
 from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import signal
 import subprocess
@@ -33,24 +33,27 @@ import warnings
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
+import fuzz_domains as fd  # noqa: E402  (tests/ is on the path; after aftmesh on purpose)
 import numpy as np
 import pytest
 import shapely
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
-from shapely.geometry import (GeometryCollection, LineString, MultiPolygon, Point,
-                              Polygon, box)
+from shapely.geometry import GeometryCollection, LineString, MultiPolygon, Point, Polygon, box
 
 import aftmesh
+from aftmesh import (  # noqa: E402
+    CrossingSegmentsError,
+    InvalidDomainError,
+    InvalidInputError,
+    InvalidOptionError,
+    InvalidSizeError,
+)
+from aftmesh.aft import Strategy  # noqa: E402
 
 # child processes import the same aftmesh as this one (installed, or src/ in a
 # development checkout)
 PACKAGE_ROOT = os.path.dirname(os.path.dirname(os.path.abspath(aftmesh.__file__)))
-from aftmesh.aft import Strategy
-from aftmesh import (CrossingSegmentsError, InvalidDomainError, InvalidInputError,
-                     InvalidOptionError, InvalidSizeError)
-
-import fuzz_domains as fd
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -59,21 +62,27 @@ ROOT = HERE.parent
 # one); beyond it the call counts as a hang.
 GEN_TIMEOUT = 20.0
 
-_SUPPRESS = [HealthCheck.function_scoped_fixture, HealthCheck.too_slow,
-             HealthCheck.data_too_large, HealthCheck.filter_too_much]
+_SUPPRESS = [
+    HealthCheck.function_scoped_fixture,
+    HealthCheck.too_slow,
+    HealthCheck.data_too_large,
+    HealthCheck.filter_too_much,
+]
 
 
 def budget(fraction: float, minimum: int = 5) -> settings:
     """A share of the active profile's max_examples (ci: 60, long: 2000)."""
-    return settings(max_examples=max(minimum, int(settings.default.max_examples * fraction)),
-                    suppress_health_check=_SUPPRESS)
+    return settings(
+        max_examples=max(minimum, int(settings.default.max_examples * fraction)),
+        suppress_health_check=_SUPPRESS,
+    )
 
 
 def same_arrays(a, b) -> bool:
-    return all(np.array_equal(getattr(a, k), getattr(b, k)) and
-               getattr(a, k).dtype == getattr(b, k).dtype
-               for k in ("points", "triangles", "neighbors", "segments", "regions",
-                         "segment_markers"))
+    return all(
+        np.array_equal(getattr(a, k), getattr(b, k)) and getattr(a, k).dtype == getattr(b, k).dtype
+        for k in ("points", "triangles", "neighbors", "segments", "regions", "segment_markers")
+    )
 
 
 def digest(mesh) -> str:
@@ -105,30 +114,39 @@ def test_valid_domains_mesh_with_any_options(case, checked):
 
 
 @budget(0.2)
-@given(case=fd.fuzz_cases(kinds=["star", "holes", "touching", "cocircular"],
-                          transform=False, forms=False))
+@given(
+    case=fd.fuzz_cases(
+        kinds=["star", "holes", "touching", "cocircular"], transform=False, forms=False
+    )
+)
 def test_far_from_origin_and_tiny_same_topology(case, checked):
     """The same domain at scale 1, scaled by 2**-20 and moved by 2**24 (exactly, or
     nearly: rounding at 2**24) gives a valid mesh each time."""
     mesh = fd.run_case(case, check=checked, timeout=GEN_TIMEOUT)
-    s = 2.0 ** -20
-    small = fd.FuzzCase(case.kind + "*2^-20",
-                        shapely.transform(case.domain, lambda c: c * s)
-                        if isinstance(case.domain, shapely.Geometry)
-                        else [shapely.transform(p, lambda c: c * s) for p in case.domain],
-                        _scaled_size(case.size, s), dict(case.options),
-                        [shapely.transform(p, lambda c: c * s) for p in case.polygons])
+    s = 2.0**-20
+    small = fd.FuzzCase(
+        case.kind + "*2^-20",
+        shapely.transform(case.domain, lambda c: c * s)
+        if isinstance(case.domain, shapely.Geometry)
+        else [shapely.transform(p, lambda c: c * s) for p in case.domain],
+        _scaled_size(case.size, s),
+        dict(case.options),
+        [shapely.transform(p, lambda c: c * s) for p in case.polygons],
+    )
     small_mesh = fd.run_case(small, check=checked, timeout=GEN_TIMEOUT)
     # (not asserted: the same mesh, scaled.  The boundary's split points differ in the
     # last bits between scales (log / exp in the integration of 1/h), and Basic_aft's
     # choices follow such differences, so the meshes may differ.)
     assert (mesh is None) == (small_mesh is None)
-    far = fd.FuzzCase(case.kind + "+2^24",
-                      shapely.transform(case.domain, lambda c: c + 2.0 ** 24)
-                      if isinstance(case.domain, shapely.Geometry)
-                      else [shapely.transform(p, lambda c: c + 2.0 ** 24) for p in case.domain],
-                      _shifted_size(case.size, 2.0 ** 24), dict(case.options),
-                      [shapely.transform(p, lambda c: c + 2.0 ** 24) for p in case.polygons])
+    far = fd.FuzzCase(
+        case.kind + "+2^24",
+        shapely.transform(case.domain, lambda c: c + 2.0**24)
+        if isinstance(case.domain, shapely.Geometry)
+        else [shapely.transform(p, lambda c: c + 2.0**24) for p in case.domain],
+        _shifted_size(case.size, 2.0**24),
+        dict(case.options),
+        [shapely.transform(p, lambda c: c + 2.0**24) for p in case.polygons],
+    )
     fd.run_case(far, check=checked, timeout=GEN_TIMEOUT)
 
 
@@ -162,8 +180,13 @@ def test_hundreds_of_exactly_cocircular_vertices(checked):
     case = fd.FuzzCase("lattice324", Polygon(P), 2000.0, {}, [Polygon(P)])
     mesh = fd.run_case(case, check=checked, timeout=60)
     assert mesh.n_triangles > len(P)
-    greedy = fd.FuzzCase("lattice324-greedy", Polygon(P), None,
-                         {"greedy": True, "split_boundary": False}, [Polygon(P)])
+    greedy = fd.FuzzCase(
+        "lattice324-greedy",
+        Polygon(P),
+        None,
+        {"greedy": True, "split_boundary": False},
+        [Polygon(P)],
+    )
     mesh = fd.run_case(greedy, check=checked, timeout=60)
     assert mesh.n_triangles == len(P) - 2
 
@@ -173,8 +196,7 @@ def test_regular_polygon_800_with_center_hole(checked):
     hole = 0.5 * np.c_[np.cos(t[::2]), np.sin(t[::2])]
     poly = Polygon(np.c_[np.cos(t), np.sin(t)], [hole])
     for opts in ({}, {"greedy": True, "split_boundary": False}, {"order": "oldest"}):
-        fd.run_case(fd.FuzzCase("ngon800", poly, 0.05, opts, [poly]), check=checked,
-                    timeout=60)
+        fd.run_case(fd.FuzzCase("ngon800", poly, 0.05, opts, [poly]), check=checked, timeout=60)
 
 
 @pytest.mark.parametrize("gap", [1e-7, 1e-9])
@@ -183,8 +205,9 @@ def test_hole_nearly_touching_outer_ring(gap, scale, checked):
     """A diamond hole whose tip is gap * size away from the outer ring."""
     hole = np.array([(gap, 1.0), (0.5, 0.7), (1.0, 1.0), (0.5, 1.3)]) * scale
     poly = Polygon(np.array([(0, 0), (2, 0), (2, 2), (0, 2)]) * scale, [hole])
-    fd.run_case(fd.FuzzCase("near", poly, 0.2 * scale, {}, [poly]), check=checked,
-                timeout=GEN_TIMEOUT)
+    fd.run_case(
+        fd.FuzzCase("near", poly, 0.2 * scale, {}, [poly]), check=checked, timeout=GEN_TIMEOUT
+    )
 
 
 # =========================================================== 2. invalid input is named
@@ -205,85 +228,221 @@ INVALID = [
     ("domain-int", lambda: aftmesh.generate(7, 0.1), InvalidDomainError, ["int"]),
     ("domain-object", lambda: aftmesh.generate(object(), 0.1), InvalidDomainError, ["object"]),
     ("domain-empty-list", lambda: aftmesh.generate([], 0.1), InvalidDomainError, ["empty"]),
-    ("domain-empty-polygon", lambda: aftmesh.generate(Polygon(), 0.1), InvalidDomainError, ["empty"]),
-    ("domain-line", lambda: aftmesh.generate(LineString([(0, 0), (1, 1)]), 0.1),
-     InvalidDomainError, ["polygon"]),
+    (
+        "domain-empty-polygon",
+        lambda: aftmesh.generate(Polygon(), 0.1),
+        InvalidDomainError,
+        ["empty"],
+    ),
+    (
+        "domain-line",
+        lambda: aftmesh.generate(LineString([(0, 0), (1, 1)]), 0.1),
+        InvalidDomainError,
+        ["polygon"],
+    ),
     ("domain-point", lambda: aftmesh.generate(Point(0, 0), 0.1), InvalidDomainError, ["polygon"]),
-    ("ring-two-vertices", lambda: aftmesh.generate([(0, 0), (1, 0)], 0.1),
-     InvalidDomainError, ["3 vertices"]),
-    ("ring-collinear", lambda: aftmesh.generate([(0, 0), (1, 0), (2, 0)], 0.1),
-     InvalidDomainError, []),
+    (
+        "ring-two-vertices",
+        lambda: aftmesh.generate([(0, 0), (1, 0)], 0.1),
+        InvalidDomainError,
+        ["3 vertices"],
+    ),
+    (
+        "ring-collinear",
+        lambda: aftmesh.generate([(0, 0), (1, 0), (2, 0)], 0.1),
+        InvalidDomainError,
+        [],
+    ),
     ("ring-all-same", lambda: aftmesh.generate([(1, 1)] * 5, 0.1), InvalidDomainError, []),
-    ("ring-nan", lambda: aftmesh.generate([(0, 0), (1, np.nan), (0, 1)], 0.1),
-     InvalidDomainError, ["vertex 1", "not finite"]),
-    ("ring-inf", lambda: aftmesh.generate([(0, 0), (np.inf, 0), (0, 1)], 0.1),
-     InvalidDomainError, ["vertex 1", "not finite"]),
+    (
+        "ring-nan",
+        lambda: aftmesh.generate([(0, 0), (1, np.nan), (0, 1)], 0.1),
+        InvalidDomainError,
+        ["vertex 1", "not finite"],
+    ),
+    (
+        "ring-inf",
+        lambda: aftmesh.generate([(0, 0), (np.inf, 0), (0, 1)], 0.1),
+        InvalidDomainError,
+        ["vertex 1", "not finite"],
+    ),
     ("ring-3d", lambda: aftmesh.generate(np.zeros((4, 3)), 0.1), InvalidDomainError, []),
-    ("bowtie", lambda: aftmesh.generate([(0, 0), (1, 1), (1, 0), (0, 1)], 0.1),
-     InvalidDomainError, ["self-intersection"]),
-    ("hole-self-intersecting",
-     lambda: aftmesh.generate(Polygon(SQ.exterior.coords,
-                                      [[(0.2, 0.2), (0.8, 0.8), (0.8, 0.2), (0.2, 0.8)]]), 0.1),
-     InvalidDomainError, ["hole 0"]),
-    ("hole-outside",
-     lambda: aftmesh.generate(Polygon(SQ.exterior.coords,
-                                      [[(2, 2), (3, 2), (3, 3)]]), 0.1),
-     InvalidDomainError, ["hole 0"]),
-    ("regions-overlap", lambda: aftmesh.generate([box(0, 0, 2, 2), box(1, 1, 3, 3)], 0.1),
-     InvalidDomainError, ["regions 0 and 1", "overlap"]),
-    ("region-not-polygon", lambda: aftmesh.generate([SQ, "square"], 0.1),
-     InvalidDomainError, ["region 1"]),
-    ("region-ring-too-short", lambda: aftmesh.generate([SQ, [(2, 0), (3, 0)]], 0.1),
-     InvalidInputError, ["region 1"]),
-    ("constraint-outside",
-     lambda: aftmesh.generate(GeometryCollection([SQ, LineString([(0.5, 0.5), (2, 2)])]), 0.1),
-     InvalidDomainError, ["constraint line 0"]),
-    ("fixed-point-outside",
-     lambda: aftmesh.generate(GeometryCollection([SQ, Point(3, 3)]), 0.1),
-     InvalidDomainError, ["fixed point 0"]),
-    ("huge-coordinates", lambda: aftmesh.generate([(0, 0), (1e300, 0), (0, 1e300)], 1e299),
-     InvalidInputError, []),
-    ("missing-file", lambda: aftmesh.generate("/nonexistent/x.poly", 0.1),
-     InvalidInputError, ["/nonexistent/x.poly"]),
+    (
+        "bowtie",
+        lambda: aftmesh.generate([(0, 0), (1, 1), (1, 0), (0, 1)], 0.1),
+        InvalidDomainError,
+        ["self-intersection"],
+    ),
+    (
+        "hole-self-intersecting",
+        lambda: aftmesh.generate(
+            Polygon(SQ.exterior.coords, [[(0.2, 0.2), (0.8, 0.8), (0.8, 0.2), (0.2, 0.8)]]), 0.1
+        ),
+        InvalidDomainError,
+        ["hole 0"],
+    ),
+    (
+        "hole-outside",
+        lambda: aftmesh.generate(Polygon(SQ.exterior.coords, [[(2, 2), (3, 2), (3, 3)]]), 0.1),
+        InvalidDomainError,
+        ["hole 0"],
+    ),
+    (
+        "regions-overlap",
+        lambda: aftmesh.generate([box(0, 0, 2, 2), box(1, 1, 3, 3)], 0.1),
+        InvalidDomainError,
+        ["regions 0 and 1", "overlap"],
+    ),
+    (
+        "region-not-polygon",
+        lambda: aftmesh.generate([SQ, "square"], 0.1),
+        InvalidDomainError,
+        ["region 1"],
+    ),
+    (
+        "region-ring-too-short",
+        lambda: aftmesh.generate([SQ, [(2, 0), (3, 0)]], 0.1),
+        InvalidInputError,
+        ["region 1"],
+    ),
+    (
+        "constraint-outside",
+        lambda: aftmesh.generate(GeometryCollection([SQ, LineString([(0.5, 0.5), (2, 2)])]), 0.1),
+        InvalidDomainError,
+        ["constraint line 0"],
+    ),
+    (
+        "fixed-point-outside",
+        lambda: aftmesh.generate(GeometryCollection([SQ, Point(3, 3)]), 0.1),
+        InvalidDomainError,
+        ["fixed point 0"],
+    ),
+    (
+        "huge-coordinates",
+        lambda: aftmesh.generate([(0, 0), (1e300, 0), (0, 1e300)], 1e299),
+        InvalidInputError,
+        [],
+    ),
+    (
+        "missing-file",
+        lambda: aftmesh.generate("/nonexistent/x.poly", 0.1),
+        InvalidInputError,
+        ["/nonexistent/x.poly"],
+    ),
     # the dict form
-    ("dict-no-vertices", lambda: aftmesh.generate({"segments": [(0, 1)]}, 0.1),
-     InvalidInputError, ["vertices"]),
-    ("dict-vertices-shape", lambda: aftmesh.generate(_dict(vertices=[(0, 0, 0)] * 3), 0.1),
-     InvalidInputError, ["vertices", "shape"]),
-    ("dict-vertices-text", lambda: aftmesh.generate(_dict(vertices="abc"), 0.1),
-     InvalidInputError, ["vertices"]),
-    ("dict-vertex-nan", lambda: aftmesh.generate(_dict(vertices=[(0, 0), (1, 0), (0, np.nan)]), 0.1),
-     InvalidInputError, ["vertices[2]", "not finite"]),
-    ("dict-segment-out-of-range", lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 3), (2, 0)]), 0.1),
-     InvalidInputError, ["segments[1]", "outside"]),
-    ("dict-segment-negative", lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 2), (2, -1)]), 0.1),
-     InvalidInputError, ["segments[2]"]),
-    ("dict-segment-float", lambda: aftmesh.generate(_dict(segments=[(0, 1.5)]), 0.1),
-     InvalidInputError, ["integer"]),
-    ("dict-segment-zero-length", lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 1), (2, 0)]), 0.1),
-     InvalidInputError, ["segments[1]", "zero length"]),
-    ("dict-segment-shape", lambda: aftmesh.generate(_dict(segments=[0, 1, 2]), 0.1),
-     InvalidInputError, ["segments", "shape"]),
-    ("dict-crossing",
-     lambda: aftmesh.generate({"vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
-                               "segments": [(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)]}),
-     CrossingSegmentsError, ["cross"]),
-    ("dict-open", lambda: aftmesh.generate(_dict(segments=[(0, 1)]), 0.1),
-     InvalidDomainError, ["encloses no area"]),
-    ("dict-hole-outside", lambda: aftmesh.generate(_dict(holes=[(5, 5)]), 0.1),
-     InvalidDomainError, ["holes[0]", "not inside"]),
-    ("dict-hole-nan", lambda: aftmesh.generate(_dict(holes=[(np.nan, 0)]), 0.1),
-     InvalidInputError, ["holes[0]"]),
-    ("dict-all-hole", lambda: aftmesh.generate(_dict(holes=[(0.2, 0.2)]), 0.1),
-     InvalidDomainError, []),
-    ("dict-regions-shape", lambda: aftmesh.generate(_dict(regions=[(0.1, 0.1)]), 0.1),
-     InvalidInputError, ["regions"]),
-    ("dict-region-marker-fraction", lambda: aftmesh.generate(_dict(regions=[(0.1, 0.1, 1.5)]), 0.1),
-     InvalidInputError, ["marker", "integer"]),
-    ("dict-segment-markers-length", lambda: aftmesh.generate(_dict(segment_markers=[1, 2]), 0.1),
-     InvalidInputError, ["segment_markers"]),
-    ("dict-segment-markers-float", lambda: aftmesh.generate(_dict(segment_markers=[1.5, 2, 3]), 0.1),
-     InvalidInputError, ["segment_markers", "integer"]),
+    (
+        "dict-no-vertices",
+        lambda: aftmesh.generate({"segments": [(0, 1)]}, 0.1),
+        InvalidInputError,
+        ["vertices"],
+    ),
+    (
+        "dict-vertices-shape",
+        lambda: aftmesh.generate(_dict(vertices=[(0, 0, 0)] * 3), 0.1),
+        InvalidInputError,
+        ["vertices", "shape"],
+    ),
+    (
+        "dict-vertices-text",
+        lambda: aftmesh.generate(_dict(vertices="abc"), 0.1),
+        InvalidInputError,
+        ["vertices"],
+    ),
+    (
+        "dict-vertex-nan",
+        lambda: aftmesh.generate(_dict(vertices=[(0, 0), (1, 0), (0, np.nan)]), 0.1),
+        InvalidInputError,
+        ["vertices[2]", "not finite"],
+    ),
+    (
+        "dict-segment-out-of-range",
+        lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 3), (2, 0)]), 0.1),
+        InvalidInputError,
+        ["segments[1]", "outside"],
+    ),
+    (
+        "dict-segment-negative",
+        lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 2), (2, -1)]), 0.1),
+        InvalidInputError,
+        ["segments[2]"],
+    ),
+    (
+        "dict-segment-float",
+        lambda: aftmesh.generate(_dict(segments=[(0, 1.5)]), 0.1),
+        InvalidInputError,
+        ["integer"],
+    ),
+    (
+        "dict-segment-zero-length",
+        lambda: aftmesh.generate(_dict(segments=[(0, 1), (1, 1), (2, 0)]), 0.1),
+        InvalidInputError,
+        ["segments[1]", "zero length"],
+    ),
+    (
+        "dict-segment-shape",
+        lambda: aftmesh.generate(_dict(segments=[0, 1, 2]), 0.1),
+        InvalidInputError,
+        ["segments", "shape"],
+    ),
+    (
+        "dict-crossing",
+        lambda: aftmesh.generate(
+            {
+                "vertices": [(0, 0), (1, 0), (1, 1), (0, 1)],
+                "segments": [(0, 2), (1, 3), (0, 1), (1, 2), (2, 3), (3, 0)],
+            }
+        ),
+        CrossingSegmentsError,
+        ["cross"],
+    ),
+    (
+        "dict-open",
+        lambda: aftmesh.generate(_dict(segments=[(0, 1)]), 0.1),
+        InvalidDomainError,
+        ["encloses no area"],
+    ),
+    (
+        "dict-hole-outside",
+        lambda: aftmesh.generate(_dict(holes=[(5, 5)]), 0.1),
+        InvalidDomainError,
+        ["holes[0]", "not inside"],
+    ),
+    (
+        "dict-hole-nan",
+        lambda: aftmesh.generate(_dict(holes=[(np.nan, 0)]), 0.1),
+        InvalidInputError,
+        ["holes[0]"],
+    ),
+    (
+        "dict-all-hole",
+        lambda: aftmesh.generate(_dict(holes=[(0.2, 0.2)]), 0.1),
+        InvalidDomainError,
+        [],
+    ),
+    (
+        "dict-regions-shape",
+        lambda: aftmesh.generate(_dict(regions=[(0.1, 0.1)]), 0.1),
+        InvalidInputError,
+        ["regions"],
+    ),
+    (
+        "dict-region-marker-fraction",
+        lambda: aftmesh.generate(_dict(regions=[(0.1, 0.1, 1.5)]), 0.1),
+        InvalidInputError,
+        ["marker", "integer"],
+    ),
+    (
+        "dict-segment-markers-length",
+        lambda: aftmesh.generate(_dict(segment_markers=[1, 2]), 0.1),
+        InvalidInputError,
+        ["segment_markers"],
+    ),
+    (
+        "dict-segment-markers-float",
+        lambda: aftmesh.generate(_dict(segment_markers=[1.5, 2, 3]), 0.1),
+        InvalidInputError,
+        ["segment_markers", "integer"],
+    ),
     # sizes
     ("size-negative", lambda: aftmesh.generate(SQ, -0.1), InvalidSizeError, ["positive"]),
     ("size-zero", lambda: aftmesh.generate(SQ, 0.0), InvalidSizeError, ["positive"]),
@@ -293,78 +452,209 @@ INVALID = [
     ("size-complex", lambda: aftmesh.generate(SQ, 0.1 + 1j), InvalidSizeError, ["size"]),
     ("size-numeric-text", lambda: aftmesh.generate(SQ, "0.1"), InvalidSizeError, ["'0.1'"]),
     ("size-bool", lambda: aftmesh.generate(SQ, True), InvalidSizeError, ["true"]),
-    ("size-per-region-bool", lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1, True]),
-     InvalidSizeError, ["size[1]"]),
-    ("size-below-resolution", lambda: aftmesh.generate(box(1e6, 0, 1e6 + 1, 1), 1e-9),
-     InvalidSizeError, ["resolve", "1e-09"]),
-    ("size-callable-below-resolution",
-     lambda: aftmesh.generate(box(1e6, 0, 1e6 + 1, 1), lambda x, y: 1e-9 + 0 * x),
-     InvalidSizeError, ["resolve", "callable"]),
-    ("size-wrong-count", lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1]),
-     InvalidSizeError, ["1 sizes", "2 regions"]),
-    ("size-per-region-nan", lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1, np.nan]),
-     InvalidSizeError, ["size[1]"]),
+    (
+        "size-per-region-bool",
+        lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1, True]),
+        InvalidSizeError,
+        ["size[1]"],
+    ),
+    (
+        "size-below-resolution",
+        lambda: aftmesh.generate(box(1e6, 0, 1e6 + 1, 1), 1e-9),
+        InvalidSizeError,
+        ["resolve", "1e-09"],
+    ),
+    (
+        "size-callable-below-resolution",
+        lambda: aftmesh.generate(box(1e6, 0, 1e6 + 1, 1), lambda x, y: 1e-9 + 0 * x),
+        InvalidSizeError,
+        ["resolve", "callable"],
+    ),
+    (
+        "size-wrong-count",
+        lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1]),
+        InvalidSizeError,
+        ["1 sizes", "2 regions"],
+    ),
+    (
+        "size-per-region-nan",
+        lambda: aftmesh.generate([SQ, box(1, 0, 2, 1)], [0.1, np.nan]),
+        InvalidSizeError,
+        ["size[1]"],
+    ),
     ("size-list-for-dict", lambda: aftmesh.generate(TRI, [0.1]), InvalidSizeError, ["region"]),
-    ("size-callable-raises", lambda: aftmesh.generate(SQ, lambda x, y: 1 / 0),
-     InvalidSizeError, ["zerodivisionerror"]),
-    ("size-callable-wrong-shape", lambda: aftmesh.generate(SQ, lambda x, y: np.ones(3)),
-     InvalidSizeError, ["shape"]),
+    (
+        "size-callable-raises",
+        lambda: aftmesh.generate(SQ, lambda x, y: 1 / 0),
+        InvalidSizeError,
+        ["zerodivisionerror"],
+    ),
+    (
+        "size-callable-wrong-shape",
+        lambda: aftmesh.generate(SQ, lambda x, y: np.ones(3)),
+        InvalidSizeError,
+        ["shape"],
+    ),
     ("size-callable-text", lambda: aftmesh.generate(SQ, lambda x, y: "big"), InvalidSizeError, []),
-    ("size-callable-negative", lambda: aftmesh.generate(SQ, lambda x, y: x - 2),
-     InvalidSizeError, ["finite and positive"]),
-    ("size-callable-nan-spot",
-     lambda: aftmesh.generate(SQ, lambda x, y: np.where(np.hypot(x - 0.5, y - 0.5) < 0.1, np.nan, 0.1)),
-     InvalidSizeError, ["nan"]),
-    ("size-none-no-edges", lambda: aftmesh.generate({"vertices": [(0, 0), (1, 0), (0, 1)]}),
-     InvalidInputError, []),
+    (
+        "size-callable-negative",
+        lambda: aftmesh.generate(SQ, lambda x, y: x - 2),
+        InvalidSizeError,
+        ["finite and positive"],
+    ),
+    (
+        "size-callable-nan-spot",
+        lambda: aftmesh.generate(
+            SQ, lambda x, y: np.where(np.hypot(x - 0.5, y - 0.5) < 0.1, np.nan, 0.1)
+        ),
+        InvalidSizeError,
+        ["nan"],
+    ),
+    (
+        "size-none-no-edges",
+        lambda: aftmesh.generate({"vertices": [(0, 0), (1, 0), (0, 1)]}),
+        InvalidInputError,
+        [],
+    ),
     # options
     ("order", lambda: aftmesh.generate(SQ, 0.1, order="random"), InvalidOptionError, ["order"]),
-    ("order-unhashable", lambda: aftmesh.generate(SQ, 0.1, order=[]), InvalidOptionError, ["order"]),
-    ("max-triangles-zero", lambda: aftmesh.generate(SQ, 0.1, max_triangles=0),
-     InvalidOptionError, ["max_triangles"]),
-    ("max-triangles-float", lambda: aftmesh.generate(SQ, 0.1, max_triangles=10.0),
-     InvalidOptionError, ["max_triangles"]),
-    ("max-triangles-bool", lambda: aftmesh.generate(SQ, 0.1, max_triangles=True),
-     InvalidOptionError, ["max_triangles"]),
-    ("max-triangles-below-boundary", lambda: aftmesh.generate(SQ, 0.1, max_triangles=3),
-     InvalidSizeError, ["triangles", "3"]),
-    ("min-area-negative", lambda: aftmesh.generate(SQ, 0.1, min_area=-1.0),
-     InvalidOptionError, ["min_area"]),
-    ("min-area-empty-list", lambda: aftmesh.generate(SQ, 0.1, min_area=[]),
-     InvalidOptionError, ["min_area"]),
-    ("min-area-text", lambda: aftmesh.generate(SQ, 0.1, min_area="small"),
-     InvalidOptionError, ["min_area"]),
-    ("close-factor-2", lambda: aftmesh.generate(SQ, 0.1, close_factor=2.0),
-     InvalidOptionError, ["close_factor"]),
-    ("close-factor-none", lambda: aftmesh.generate(SQ, 0.1, close_factor=None),
-     InvalidOptionError, ["close_factor"]),
-    ("gradation-below-1", lambda: aftmesh.generate(SQ, 0.1, gradation=0.5),
-     InvalidSizeError, ["gradation"]),
-    ("gradation-text", lambda: aftmesh.generate(SQ, 0.1, gradation="fast"),
-     InvalidInputError, ["gradation"]),
-    ("smooth-negative", lambda: aftmesh.generate(SQ, 0.1, smooth=-1), InvalidOptionError, ["smooth"]),
+    (
+        "order-unhashable",
+        lambda: aftmesh.generate(SQ, 0.1, order=[]),
+        InvalidOptionError,
+        ["order"],
+    ),
+    (
+        "max-triangles-zero",
+        lambda: aftmesh.generate(SQ, 0.1, max_triangles=0),
+        InvalidOptionError,
+        ["max_triangles"],
+    ),
+    (
+        "max-triangles-float",
+        lambda: aftmesh.generate(SQ, 0.1, max_triangles=10.0),
+        InvalidOptionError,
+        ["max_triangles"],
+    ),
+    (
+        "max-triangles-bool",
+        lambda: aftmesh.generate(SQ, 0.1, max_triangles=True),
+        InvalidOptionError,
+        ["max_triangles"],
+    ),
+    (
+        "max-triangles-below-boundary",
+        lambda: aftmesh.generate(SQ, 0.1, max_triangles=3),
+        InvalidSizeError,
+        ["triangles", "3"],
+    ),
+    (
+        "min-area-negative",
+        lambda: aftmesh.generate(SQ, 0.1, min_area=-1.0),
+        InvalidOptionError,
+        ["min_area"],
+    ),
+    (
+        "min-area-empty-list",
+        lambda: aftmesh.generate(SQ, 0.1, min_area=[]),
+        InvalidOptionError,
+        ["min_area"],
+    ),
+    (
+        "min-area-text",
+        lambda: aftmesh.generate(SQ, 0.1, min_area="small"),
+        InvalidOptionError,
+        ["min_area"],
+    ),
+    (
+        "close-factor-2",
+        lambda: aftmesh.generate(SQ, 0.1, close_factor=2.0),
+        InvalidOptionError,
+        ["close_factor"],
+    ),
+    (
+        "close-factor-none",
+        lambda: aftmesh.generate(SQ, 0.1, close_factor=None),
+        InvalidOptionError,
+        ["close_factor"],
+    ),
+    (
+        "gradation-below-1",
+        lambda: aftmesh.generate(SQ, 0.1, gradation=0.5),
+        InvalidSizeError,
+        ["gradation"],
+    ),
+    (
+        "gradation-text",
+        lambda: aftmesh.generate(SQ, 0.1, gradation="fast"),
+        InvalidInputError,
+        ["gradation"],
+    ),
+    (
+        "smooth-negative",
+        lambda: aftmesh.generate(SQ, 0.1, smooth=-1),
+        InvalidOptionError,
+        ["smooth"],
+    ),
     ("smooth-float", lambda: aftmesh.generate(SQ, 0.1, smooth=1.5), InvalidOptionError, ["smooth"]),
-    ("greedy-text", lambda: aftmesh.generate(SQ, 0.1, greedy="yes"), InvalidOptionError, ["greedy"]),
+    (
+        "greedy-text",
+        lambda: aftmesh.generate(SQ, 0.1, greedy="yes"),
+        InvalidOptionError,
+        ["greedy"],
+    ),
     ("swaps-int", lambda: aftmesh.generate(SQ, 0.1, swaps=1), InvalidOptionError, ["swaps"]),
-    ("split-none", lambda: aftmesh.generate(SQ, 0.1, split_boundary=None),
-     InvalidOptionError, ["split_boundary"]),
-    ("strategy-int", lambda: aftmesh.generate(SQ, 0.1, strategy=1), InvalidOptionError, ["strategy"]),
+    (
+        "split-none",
+        lambda: aftmesh.generate(SQ, 0.1, split_boundary=None),
+        InvalidOptionError,
+        ["split_boundary"],
+    ),
+    (
+        "strategy-int",
+        lambda: aftmesh.generate(SQ, 0.1, strategy=1),
+        InvalidOptionError,
+        ["strategy"],
+    ),
     # cdt()
     ("cdt-one-point", lambda: aftmesh.cdt([(0, 0)]), InvalidDomainError, ["3 vertices"]),
-    ("cdt-collinear", lambda: aftmesh.cdt([(0, 0), (1, 1), (2, 2), (3, 3)]),
-     InvalidDomainError, ["collinear"]),
+    (
+        "cdt-collinear",
+        lambda: aftmesh.cdt([(0, 0), (1, 1), (2, 2), (3, 3)]),
+        InvalidDomainError,
+        ["collinear"],
+    ),
     ("cdt-text", lambda: aftmesh.cdt("points"), InvalidInputError, ["vertices"]),
-    ("cdt-segments-3d", lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], np.zeros((1, 2, 2), int)),
-     InvalidInputError, ["segments", "shape"]),
-    ("cdt-segments-uint64", lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)],
-                                                np.array([[2 ** 63, 1]], dtype=np.uint64)),
-     InvalidInputError, ["segments[0]"]),
-    ("cdt-crossing", lambda: aftmesh.cdt([(0, 0), (1, 0), (1, 1), (0, 1)], [(0, 2), (1, 3)]),
-     CrossingSegmentsError, ["segments[1]", "segments[0]"]),
-    ("cdt-regions-text", lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], regions="abc"),
-     InvalidInputError, ["regions"]),
-    ("cdt-holes-shape", lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], holes=[1, 2, 3]),
-     InvalidInputError, ["holes"]),
+    (
+        "cdt-segments-3d",
+        lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], np.zeros((1, 2, 2), int)),
+        InvalidInputError,
+        ["segments", "shape"],
+    ),
+    (
+        "cdt-segments-uint64",
+        lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], np.array([[2**63, 1]], dtype=np.uint64)),
+        InvalidInputError,
+        ["segments[0]"],
+    ),
+    (
+        "cdt-crossing",
+        lambda: aftmesh.cdt([(0, 0), (1, 0), (1, 1), (0, 1)], [(0, 2), (1, 3)]),
+        CrossingSegmentsError,
+        ["segments[1]", "segments[0]"],
+    ),
+    (
+        "cdt-regions-text",
+        lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], regions="abc"),
+        InvalidInputError,
+        ["regions"],
+    ),
+    (
+        "cdt-holes-shape",
+        lambda: aftmesh.cdt([(0, 0), (1, 0), (0, 1)], holes=[1, 2, 3]),
+        InvalidInputError,
+        ["holes"],
+    ),
 ]
 
 
@@ -381,18 +671,27 @@ def test_invalid_input_named(name, call, error, words):
 
 
 # ------------------------------------------------------------------ random garbage
-_FLOATS = st.one_of(st.floats(allow_nan=True, allow_infinity=True),
-                    st.sampled_from([0.0, -0.0, 1e300, -1e300, 5e-324, 1e-300, 1e100, 1.0]))
-_SCALARS = st.one_of(st.none(), st.booleans(), _FLOATS,
-                     st.integers(-2 ** 70, 2 ** 70), st.integers(-3, 5),
-                     st.text(max_size=6), st.binary(max_size=6),
-                     st.complex_numbers(allow_nan=True, allow_infinity=True))
+_FLOATS = st.one_of(
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0.0, -0.0, 1e300, -1e300, 5e-324, 1e-300, 1e100, 1.0]),
+)
+_SCALARS = st.one_of(
+    st.none(),
+    st.booleans(),
+    _FLOATS,
+    st.integers(-(2**70), 2**70),
+    st.integers(-3, 5),
+    st.text(max_size=6),
+    st.binary(max_size=6),
+    st.complex_numbers(allow_nan=True, allow_infinity=True),
+)
 
 
 @st.composite
 def _arrays(draw):
-    shape = draw(st.sampled_from([(), (0,), (0, 2), (3,), (3, 2), (4, 2), (2, 3), (3, 2, 2),
-                                  (1, 1), (5, 2)]))
+    shape = draw(
+        st.sampled_from([(), (0,), (0, 2), (3,), (3, 2), (4, 2), (2, 3), (3, 2, 2), (1, 1), (5, 2)])
+    )
     dtype = draw(st.sampled_from(["f8", "f4", "i8", "i4", "u8", "bool", "c16", "O", "U3"]))
     n = int(np.prod(shape)) if shape else 1
     vals = draw(st.lists(st.one_of(_FLOATS, st.integers(-3, 10)), min_size=n, max_size=n))
@@ -404,19 +703,36 @@ def _arrays(draw):
         return np.array(vals, dtype=object).reshape(shape)
 
 
-_SENTINELS = st.sampled_from([object(), print, Polygon(), Point(0, 0),
-                              LineString([(0, 0), (1, 1)]), GeometryCollection(),
-                              Polygon([(0, 0), (1, 0), (np.nan, 1)]), MultiPolygon(),
-                              range(3), b"\x00\x01", "", "POLYGON ((0 0, 1 0, 0 1, 0 0))"])
+_SENTINELS = st.sampled_from(
+    [
+        object(),
+        print,
+        Polygon(),
+        Point(0, 0),
+        LineString([(0, 0), (1, 1)]),
+        GeometryCollection(),
+        Polygon([(0, 0), (1, 0), (np.nan, 1)]),
+        MultiPolygon(),
+        range(3),
+        b"\x00\x01",
+        "",
+        "POLYGON ((0 0, 1 0, 0 1, 0 0))",
+    ]
+)
 
 garbage = st.recursive(
     st.one_of(_SCALARS, _arrays(), _SENTINELS),
-    lambda inner: st.one_of(st.lists(inner, max_size=5),
-                            st.lists(inner, max_size=5).map(tuple),
-                            st.dictionaries(st.sampled_from(["vertices", "segments", "holes",
-                                                             "regions", "segment_markers",
-                                                             "x"]), inner, max_size=4)),
-    max_leaves=12)
+    lambda inner: st.one_of(
+        st.lists(inner, max_size=5),
+        st.lists(inner, max_size=5).map(tuple),
+        st.dictionaries(
+            st.sampled_from(["vertices", "segments", "holes", "regions", "segment_markers", "x"]),
+            inner,
+            max_size=4,
+        ),
+    ),
+    max_leaves=12,
+)
 
 
 @st.composite
@@ -446,9 +762,10 @@ def _outcome(call, checked):
         return exc
     except (fd.Hang, fd.Crash):
         raise
-    except BaseException as exc:                      # noqa: BLE001
-        raise AssertionError(f"{type(exc).__name__} escaped: {exc}"
-                             f"\n{getattr(exc, 'child_traceback', '')}") from exc
+    except BaseException as exc:  # noqa: BLE001
+        raise AssertionError(
+            f"{type(exc).__name__} escaped: {exc}\n{getattr(exc, 'child_traceback', '')}"
+        ) from exc
     if isinstance(mesh, aftmesh.Mesh):
         checked(mesh)
     return mesh
@@ -466,8 +783,19 @@ def test_garbage_size(size, checked):
     _outcome(lambda: aftmesh.generate(SQ, size, max_triangles=20000), checked)
 
 
-OPTIONS = ["max_triangles", "min_area", "order", "greedy", "swaps", "split_boundary",
-           "gradation", "close_factor", "smooth", "strategy", "progress"]
+OPTIONS = [
+    "max_triangles",
+    "min_area",
+    "order",
+    "greedy",
+    "swaps",
+    "split_boundary",
+    "gradation",
+    "close_factor",
+    "smooth",
+    "strategy",
+    "progress",
+]
 
 
 @budget(1.0)
@@ -480,19 +808,31 @@ def test_garbage_option(name, value, checked):
 
 
 @budget(1.0)
-@given(entries=st.dictionaries(
-    st.sampled_from(["vertices", "segments", "holes", "regions", "segment_markers"]),
-    st.one_of(garbage, st.just(TRI["vertices"]), st.just(TRI["segments"]),
-              st.just([(0.2, 0.2, 1)]), st.just([(0.2, 0.2)]), st.just([1, 2, 3])),
-    min_size=1))
+@given(
+    entries=st.dictionaries(
+        st.sampled_from(["vertices", "segments", "holes", "regions", "segment_markers"]),
+        st.one_of(
+            garbage,
+            st.just(TRI["vertices"]),
+            st.just(TRI["segments"]),
+            st.just([(0.2, 0.2, 1)]),
+            st.just([(0.2, 0.2)]),
+            st.just([1, 2, 3]),
+        ),
+        min_size=1,
+    )
+)
 def test_garbage_dict_domain(entries, checked):
     _outcome(lambda: aftmesh.generate(entries, None, max_triangles=20000), checked)
 
 
 @budget(1.0)
-@given(vertices=st.one_of(garbage, st.just([(0, 0), (1, 0), (1, 1), (0, 1)])),
-       segments=st.one_of(st.none(), garbage, st.just([(0, 1), (1, 2), (2, 3), (3, 0)])),
-       holes=st.one_of(st.none(), garbage), regions=st.one_of(st.none(), garbage))
+@given(
+    vertices=st.one_of(garbage, st.just([(0, 0), (1, 0), (1, 1), (0, 1)])),
+    segments=st.one_of(st.none(), garbage, st.just([(0, 1), (1, 2), (2, 3), (3, 0)])),
+    holes=st.one_of(st.none(), garbage),
+    regions=st.one_of(st.none(), garbage),
+)
 def test_garbage_cdt(vertices, segments, holes, regions, checked):
     _outcome(lambda: aftmesh.cdt(vertices, segments, holes=holes, regions=regions), checked)
 
@@ -500,8 +840,10 @@ def test_garbage_cdt(vertices, segments, holes, regions, checked):
 # ====================================================== 3. termination, caps, Ctrl-C
 def _spot(h0, cx=0.3, cy=0.4, base=0.1):
     """The size: base everywhere except a point-like spot of size h0."""
+
     def size(x, y):
         return np.maximum(h0, np.minimum(base, 0.5 * np.hypot(x - cx, y - cy)))
+
     return size
 
 
@@ -518,6 +860,7 @@ def test_size_tiny_in_one_spot(h0, checked):
 def test_size_bad_in_one_spot(bad):
     def size(x, y):
         return np.where(np.hypot(x - 0.3, y - 0.4) < 0.05, bad, 0.1)
+
     with pytest.raises(InvalidSizeError):
         fd.isolated(aftmesh.generate, SQ, size, timeout=GEN_TIMEOUT)
 
@@ -526,15 +869,16 @@ def test_size_bad_in_one_spot(bad):
 def test_size_bad_at_one_point_between_grid_nodes(bad, checked):
     """Bad only exactly at one point the grid may not sample: refused, or unseen and
     the mesh is fine (the kernel never reads the callable itself)."""
+
     def size(x, y):
         x = np.asarray(x, dtype=float)
         return np.where((x == 0.123456789) & (np.asarray(y) == 0.5), bad, 0.1 + 0 * x)
+
     _outcome(lambda: aftmesh.generate(SQ, size), checked)
 
 
 @budget(0.3)
-@given(case=fd.fuzz_cases(kinds=["star", "holes", "cells", "touching"]),
-       cap=st.integers(1, 400))
+@given(case=fd.fuzz_cases(kinds=["star", "holes", "cells", "touching"]), cap=st.integers(1, 400))
 def test_max_triangles_caps_the_mesh(case, cap, checked):
     case.options["max_triangles"] = cap
     mesh = fd.run_case(case, check=checked, timeout=GEN_TIMEOUT)
@@ -581,8 +925,10 @@ def test_ctrl_c_from_progress_callback(checked, time_limit):
 
 def test_progress_callback_other_errors_ignored(checked):
     """A broken progress display (any other exception) does not stop meshing."""
+
     def progress(f):
         raise RuntimeError("display broke")
+
     mesh = aftmesh.generate(SQ, 0.005, progress=progress)
     checked(mesh, domain_area=1.0)
 
@@ -611,14 +957,13 @@ def test_sigint_during_large_mesh(checked, default_sigint, time_limit):
     th = None
     try:
         try:
-            t0 = time.perf_counter()
             th, record = _interrupt_after(0.7)
             _big()
             got = "finished"
         finally:
             if th is not None:
                 th.join()
-            time.sleep(0.05)        # a late signal would land here, inside the try
+            time.sleep(0.05)  # a late signal would land here, inside the try
     except KeyboardInterrupt:
         got = time.perf_counter()
     assert got != "finished", "the large mesh finished before the signal: make it bigger"
@@ -645,14 +990,21 @@ def test_sigint_in_subprocess_exits_cleanly(time_limit):
         "except KeyboardInterrupt:\n"
         "    print('interrupted', time.perf_counter(), flush=True)\n"
         "m = aftmesh.generate(box(0, 0, 1, 1), 0.1)\n"
-        "print('after', m.n_triangles, flush=True)\n")
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([PACKAGE_ROOT,
-                                                       os.environ.get("PYTHONPATH", "")]))
-    proc = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env=env)
+        "print('after', m.n_triangles, flush=True)\n"
+    )
+    env = dict(
+        os.environ, PYTHONPATH=os.pathsep.join([PACKAGE_ROOT, os.environ.get("PYTHONPATH", "")])
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+    )
     try:
         assert proc.stdout.readline().strip() == "ready"
-        time.sleep(1.5)                 # past the imports and well into the mesh
+        time.sleep(1.5)  # past the imports and well into the mesh
         proc.send_signal(signal.SIGINT)
         sent = time.perf_counter()
         out, err = proc.communicate(timeout=30)
@@ -682,6 +1034,7 @@ def test_same_input_same_output(case):
                     raise
                 out.append(None)
         return out
+
     a, b = fd.isolated(twice, timeout=2 * GEN_TIMEOUT)
     assert (a is None) == (b is None)
     if a is not None:
@@ -701,16 +1054,24 @@ print(json.dumps([digest(c.call()) for c in cases]))
 def _determinism_cases():
     t = 2 * np.pi * np.arange(200) / 200
     ring = Polygon(np.c_[np.cos(t), np.sin(t)], [0.4 * np.c_[np.cos(t[::4]), np.sin(t[::4])]])
-    holes = Polygon(box(0, 0, 4, 3).exterior.coords,
-                    [fd._ngon(0.5 + i, 0.5 + j, 0.3, 3 + i + j, 0.1 * i) for i in range(4)
-                     for j in range(3)])
+    holes = Polygon(
+        box(0, 0, 4, 3).exterior.coords,
+        [fd._ngon(0.5 + i, 0.5 + j, 0.3, 3 + i + j, 0.1 * i) for i in range(4) for j in range(3)],
+    )
     lat = Polygon(fd.lattice_circle(5525))
     far = shapely.transform(holes, lambda c: c + 1e7)
-    cells = shapely.union_all([box(i, j, i + 1, j + 1) for i in range(4) for j in range(4)
-                               if (i + j) % 2 == 0 or i == j])
+    cells = shapely.union_all(
+        [box(i, j, i + 1, j + 1) for i in range(4) for j in range(4) if (i + j) % 2 == 0 or i == j]
+    )
     # the lines cross at (1, 0.5), exactly on both (dyadic coordinates)
-    gc = GeometryCollection([box(0, 0, 2, 1), LineString([(0.25, 0.25), (1.75, 0.75)]),
-                             LineString([(0.25, 0.75), (1.75, 0.25)]), Point(1.5, 0.5)])
+    gc = GeometryCollection(
+        [
+            box(0, 0, 2, 1),
+            LineString([(0.25, 0.25), (1.75, 0.75)]),
+            LineString([(0.25, 0.75), (1.75, 0.25)]),
+            Point(1.5, 0.5),
+        ]
+    )
     regions = [box(0, 0, 1, 1), box(1, 0, 2, 1), box(0, 1, 2, 2)]
     graded = {"kind": "point", "lo": 1e-3, "hi": 0.3, "center": [0.3, 0.3], "slope": 0.3}
     return [
@@ -733,11 +1094,18 @@ def test_same_output_across_processes(tmp_path):
     path = tmp_path / "cases.json"
     path.write_text(json.dumps([fd.case_to_json(c) for c in cases]))
     for seed in ("0", "4242"):
-        env = dict(os.environ, PYTHONHASHSEED=seed,
-                   PYTHONPATH=os.pathsep.join([PACKAGE_ROOT, str(HERE),
-                                               os.environ.get("PYTHONPATH", "")]))
-        out = subprocess.run([sys.executable, "-c", DETERMINISM_SCRIPT, str(HERE), str(path)],
-                             env=env, capture_output=True, text=True, timeout=300)
+        env = dict(
+            os.environ,
+            PYTHONHASHSEED=seed,
+            PYTHONPATH=os.pathsep.join([PACKAGE_ROOT, str(HERE), os.environ.get("PYTHONPATH", "")]),
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", DETERMINISM_SCRIPT, str(HERE), str(path)],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=300,
+        )
         assert out.returncode == 0, out.stderr
         there = json.loads(out.stdout.strip().splitlines()[-1])
         diff = [c.kind for c, a, b in zip(cases, here, there) if a != b]
@@ -756,6 +1124,7 @@ def _rss_mb() -> float:
 def _rss_growth(call, n: int = 200, warmup: int = 20) -> float:
     """RSS growth (MB) over n calls after a warm-up (run in a forked child so the
     test process's own heap does not blur it)."""
+
     def measure():
         for _ in range(warmup):
             call()
@@ -763,11 +1132,14 @@ def _rss_growth(call, n: int = 200, warmup: int = 20) -> float:
         for _ in range(n):
             call()
         return _rss_mb() - before
+
     return fd.isolated(measure, timeout=300)
 
 
-MEMORY_DOMAIN = Polygon(box(0, 0, 3, 2).exterior.coords,
-                        [fd._ngon(1.0, 1.0, 0.4, 7, 0.0), fd._ngon(2.1, 0.9, 0.5, 5, 0.3)])
+MEMORY_DOMAIN = Polygon(
+    box(0, 0, 3, 2).exterior.coords,
+    [fd._ngon(1.0, 1.0, 0.4, 7, 0.0), fd._ngon(2.1, 0.9, 0.5, 5, 0.3)],
+)
 
 
 def test_memory_flat_repeated_generate():
@@ -786,25 +1158,31 @@ def _raises(call, exc_type):
         except exc_type:
             return
         raise AssertionError("no error")
+
     return run
 
 
 @pytest.mark.parametrize("what", ["crossing", "max_triangles", "interrupt", "cdt", "python-loop"])
 def test_memory_flat_error_paths(what):
     """The same on paths that leave early with a kernel already built."""
-    crossing = {"vertices": np.r_[MEMORY_DOMAIN.exterior.coords[:-1], [(0.5, 0.5), (2.5, 1.5)],
-                                  [(0.7, 1.6), (2.2, 0.3)]],
-                "segments": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)]}
+    crossing = {
+        "vertices": np.r_[
+            MEMORY_DOMAIN.exterior.coords[:-1], [(0.5, 0.5), (2.5, 1.5)], [(0.7, 1.6), (2.2, 0.3)]
+        ],
+        "segments": [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)],
+    }
 
     def interrupt(f):
         raise KeyboardInterrupt
 
     calls = {
         "crossing": _raises(lambda: aftmesh.generate(crossing, 0.01), CrossingSegmentsError),
-        "max_triangles": _raises(lambda: aftmesh.generate(MEMORY_DOMAIN, 0.003, max_triangles=100),
-                                 InvalidSizeError),
-        "interrupt": _raises(lambda: aftmesh.generate(MEMORY_DOMAIN, 0.004, progress=interrupt),
-                             KeyboardInterrupt),
+        "max_triangles": _raises(
+            lambda: aftmesh.generate(MEMORY_DOMAIN, 0.003, max_triangles=100), InvalidSizeError
+        ),
+        "interrupt": _raises(
+            lambda: aftmesh.generate(MEMORY_DOMAIN, 0.004, progress=interrupt), KeyboardInterrupt
+        ),
         "cdt": lambda: aftmesh.cdt(np.random.default_rng(0).random((3000, 2))),
         "python-loop": lambda: aftmesh.generate(MEMORY_DOMAIN, 0.2, strategy=_PyStrategy()),
     }
@@ -840,8 +1218,10 @@ def test_thread_pool_same_meshes(record_property):
         assert same_arrays(a, b), c.kind
     record_property("serial_s", round(t_serial, 3))
     record_property("threads_s", round(t_threads, 3))
-    print(f"\n[threads] {len(cases)} meshes: serial {t_serial:.2f} s, 4 threads "
-          f"{t_threads:.2f} s (cpu count {os.cpu_count()})")
+    print(
+        f"\n[threads] {len(cases)} meshes: serial {t_serial:.2f} s, 4 threads "
+        f"{t_threads:.2f} s (cpu count {os.cpu_count()})"
+    )
 
 
 def test_threads_with_progress_callbacks():
@@ -863,6 +1243,7 @@ def test_threads_with_progress_callbacks():
 def test_interrupting_one_thread_leaves_the_others():
     """A KeyboardInterrupt raised by one thread's progress callback stops only that
     mesh."""
+
     def stop(f):
         raise KeyboardInterrupt
 
@@ -889,9 +1270,14 @@ def test_oracle_detects_broken_meshes(checked):
 
     def mesh(points=None, triangles=None):
         T = np.asarray(good.triangles if triangles is None else triangles)
-        return aftmesh.Mesh(points=good.points if points is None else points, triangles=T,
-                            neighbors=_neighbors(T), segments=good.segments,
-                            regions=np.zeros(len(T), dtype=np.int32))
+        return aftmesh.Mesh(
+            points=good.points if points is None else points,
+            triangles=T,
+            neighbors=_neighbors(T),
+            segments=good.segments,
+            regions=np.zeros(len(T), dtype=np.int32),
+        )
+
     with pytest.raises(AssertionError):
         fd.verify(mesh(triangles=good.triangles[1:]), case, checked)
     seg_pt = int(good.segments[0, 0])
@@ -901,9 +1287,13 @@ def test_oracle_detects_broken_meshes(checked):
         fd.verify(mesh(points=moved), case, checked)
     # the square (0,0) (2,0) (2,1.5) (0,1.2): the diagonal (0,0)-(2,1.5) is not Delaunay
     P = np.array([(0, 0), (2, 0), (2, 1.5), (0, 1.2)], dtype=float)
-    bad = aftmesh.Mesh(points=P, triangles=[(0, 1, 2), (0, 2, 3)],
-                       neighbors=[(-1, 1, -1), (-1, -1, 0)],
-                       segments=[(0, 1), (1, 2), (2, 3), (3, 0)], regions=[0, 0])
+    bad = aftmesh.Mesh(
+        points=P,
+        triangles=[(0, 1, 2), (0, 2, 3)],
+        neighbors=[(-1, 1, -1), (-1, -1, 0)],
+        segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
+        regions=[0, 0],
+    )
     with pytest.raises(AssertionError):
         fd.check_cdt_with_triangle(bad, np.zeros((0, 2)))
 

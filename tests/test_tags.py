@@ -1,6 +1,7 @@
 """Segment provenance and named boundary parts: ``Mesh.segment_sources``,
 ``generate(boundary_tags=...)``, ``Mesh.segment_tags`` / ``tag_names`` /
 ``boundary_facets``."""
+
 import numpy as np
 import pytest
 from shapely.geometry import GeometryCollection, LineString, Point, Polygon, box
@@ -12,8 +13,12 @@ from aftmesh.tags import resolve_boundary_tags
 # box(0, 0, 2, 1) is the ring (2,0) -> (2,1) -> (0,1) -> (0,0): edges 0..3 are
 # right, top, left, bottom
 SIDES = {"right": 0, "top": 1, "left": 2, "bottom": 3}
-SELECT = {"left": lambda x, y: x == 0, "right": lambda x, y: x == 2,
-          "bottom": lambda x, y: y == 0, "top": lambda x, y: y == 1}
+SELECT = {
+    "left": lambda x, y: x == 0,
+    "right": lambda x, y: x == 2,
+    "bottom": lambda x, y: y == 0,
+    "top": lambda x, y: y == 1,
+}
 
 
 def _on(mesh, axis, value):
@@ -25,9 +30,13 @@ def test_box_with_named_sides(checked):
     domain = box(0, 0, 2, 1)
     mesh = checked(aftmesh.generate(domain, 0.1, boundary_tags=SELECT), domain_area=2.0)
     assert mesh.tag_names == {"left": 1, "right": 2, "bottom": 3, "top": 4}
-    assert len(mesh.segments) > 40                  # every side was split into pieces
-    for name, axis, value in [("left", 0, 0.0), ("right", 0, 2.0), ("bottom", 1, 0.0),
-                              ("top", 1, 1.0)]:
+    assert len(mesh.segments) > 40  # every side was split into pieces
+    for name, axis, value in [
+        ("left", 0, 0.0),
+        ("right", 0, 2.0),
+        ("bottom", 1, 0.0),
+        ("top", 1, 1.0),
+    ]:
         on = _on(mesh, axis, value)
         assert on.sum() >= 10
         assert (mesh.segment_tags[on] == mesh.tag_names[name]).all()
@@ -42,9 +51,11 @@ def test_selectors_by_input_edge_index_and_callable_called_once(checked):
     def left(x, y):
         calls.append(len(x))
         return x == 0
-    mesh = checked(aftmesh.generate(box(0, 0, 2, 1), 0.25,
-                                    boundary_tags={"left": left, "ends": [0, 3]}),
-                   domain_area=2.0)
+
+    mesh = checked(
+        aftmesh.generate(box(0, 0, 2, 1), 0.25, boundary_tags={"left": left, "ends": [0, 3]}),
+        domain_area=2.0,
+    )
     assert calls == [4]
     ends = mesh.boundary_facets("ends")
     assert set(mesh.segment_sources[ends].tolist()) == {0, 3}
@@ -53,34 +64,44 @@ def test_selectors_by_input_edge_index_and_callable_called_once(checked):
 
 
 def test_an_edge_selected_twice_names_both_and_the_edge():
-    with pytest.raises(InvalidOptionError, match=r"input edge 2 \(the polygon, exterior ring\)"
-                       r".*both boundary_tags 'west' and 'left'"):
-        aftmesh.generate(box(0, 0, 2, 1), 0.25,
-                         boundary_tags={"west": [2], "left": SELECT["left"]})
+    with pytest.raises(
+        InvalidOptionError,
+        match=r"input edge 2 \(the polygon, exterior ring\)"
+        r".*both boundary_tags 'west' and 'left'",
+    ):
+        aftmesh.generate(box(0, 0, 2, 1), 0.25, boundary_tags={"west": [2], "left": SELECT["left"]})
 
 
-@pytest.mark.parametrize("tags, match", [
-    ({"a": [7]}, "input edge 7, but the input edges are numbered 0..3"),
-    ({"a": lambda x, y: np.ones((len(x), 2), bool)}, "boolean array of length 4"),
-    ({"a": lambda x, y: x}, "boolean array"),
-    ({"a": "left"}, "callable f\\(x, y\\) or a sequence"),
-    ([("a", [0])], "mapping"),
-    ({1: [0]}, "names must be strings"),
-])
+@pytest.mark.parametrize(
+    "tags, match",
+    [
+        ({"a": [7]}, "input edge 7, but the input edges are numbered 0..3"),
+        ({"a": lambda x, y: np.ones((len(x), 2), bool)}, "boolean array of length 4"),
+        ({"a": lambda x, y: x}, "boolean array"),
+        ({"a": "left"}, "callable f\\(x, y\\) or a sequence"),
+        ([("a", [0])], "mapping"),
+        ({1: [0]}, "names must be strings"),
+    ],
+)
 def test_bad_boundary_tags_are_refused(tags, match):
     with pytest.raises(InvalidOptionError, match=match):
         aftmesh.generate(box(0, 0, 2, 1), 0.25, boundary_tags=tags)
 
 
 def test_boundary_facets_unknown_name_lists_the_names_and_int_uses_markers():
-    mesh = aftmesh.generate(box(0, 0, 2, 1).difference(Point(1, 0.5).buffer(0.2)), 0.2,
-                            boundary_tags={"outer": lambda x, y: np.hypot(x - 1, y - 0.5) > 0.3})
+    mesh = aftmesh.generate(
+        box(0, 0, 2, 1).difference(Point(1, 0.5).buffer(0.2)),
+        0.2,
+        boundary_tags={"outer": lambda x, y: np.hypot(x - 1, y - 0.5) > 0.3},
+    )
     with pytest.raises(InvalidOptionError, match=r"'inner'.*\['outer'\]"):
         mesh.boundary_facets("inner")
-    hole = mesh.boundary_facets(1)                   # marker 1: the hole's ring
+    hole = mesh.boundary_facets(1)  # marker 1: the hole's ring
     assert len(hole) > 0 and np.array_equal(hole, np.flatnonzero(mesh.segment_markers == 1))
-    assert np.array_equal(np.sort(np.concatenate([hole, mesh.boundary_facets("outer")])),
-                          np.arange(len(mesh.segments)))
+    assert np.array_equal(
+        np.sort(np.concatenate([hole, mesh.boundary_facets("outer")])),
+        np.arange(len(mesh.segments)),
+    )
     plain = aftmesh.generate(box(0, 0, 1, 1), 0.5)
     assert plain.segment_tags is None and plain.tag_names == {}
     with pytest.raises(InvalidOptionError, match=r"no boundary part named 'x'.*\[\]"):
@@ -110,22 +131,34 @@ def test_segment_sources_count_ring_edges_then_lines(checked):
 
 
 def test_segment_sources_of_a_dict_and_of_cdt_are_segment_indices(checked):
-    d = {"vertices": [(0, 0), (2, 0), (2, 1), (0, 1)], "segments": [(0, 1), (1, 2), (2, 3), (3, 0)],
-         "segment_markers": [5, 6, 7, 8]}
+    d = {
+        "vertices": [(0, 0), (2, 0), (2, 1), (0, 1)],
+        "segments": [(0, 1), (1, 2), (2, 3), (3, 0)],
+        "segment_markers": [5, 6, 7, 8],
+    }
     mesh = checked(aftmesh.generate(d, 0.2))
     assert np.array_equal(mesh.segment_markers, np.array([5, 6, 7, 8])[mesh.segment_sources])
-    m = checked(aftmesh.cdt([(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0)],
-                            [(0, 1), (1, 2), (2, 3), (3, 0)]))
+    m = checked(
+        aftmesh.cdt([(0, 0), (1, 0), (1, 1), (0, 1), (0.5, 0)], [(0, 1), (1, 2), (2, 3), (3, 0)])
+    )
     assert np.array_equal(np.sort(m.segment_sources), [0, 0, 1, 2, 3])
 
 
 def test_mesh_fields_are_frozen_int32():
-    mesh = aftmesh.generate(box(0, 0, 1, 1), 0.5, boundary_tags={"all": lambda x, y: np.isfinite(x)})
+    mesh = aftmesh.generate(
+        box(0, 0, 1, 1), 0.5, boundary_tags={"all": lambda x, y: np.isfinite(x)}
+    )
     for name in ("segment_sources", "segment_tags"):
         arr = getattr(mesh, name)
         assert arr.dtype == np.int32 and not arr.flags.writeable
-    m = aftmesh.Mesh(mesh.points, mesh.triangles, mesh.neighbors, mesh.segments,
-                     mesh.regions, segment_sources=[0] * len(mesh.segments))
+    m = aftmesh.Mesh(
+        mesh.points,
+        mesh.triangles,
+        mesh.neighbors,
+        mesh.segments,
+        mesh.regions,
+        segment_sources=[0] * len(mesh.segments),
+    )
     assert m.segment_sources.dtype == np.int32 and not m.segment_sources.flags.writeable
     assert m.segment_tags is None and m.tag_names == {}
 

@@ -1,4 +1,5 @@
 """Mesh topology: the connected-components routine, pieces, holes, region seeds."""
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -24,8 +25,14 @@ def _same_partition(x, y):
     return len(pairs) == len(np.unique(x)) == len(np.unique(y))
 
 
-@given(st.integers(1, 60).flatmap(lambda n: st.tuples(
-    st.just(n), st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)), max_size=90))))
+@given(
+    st.integers(1, 60).flatmap(
+        lambda n: st.tuples(
+            st.just(n),
+            st.lists(st.tuples(st.integers(0, n - 1), st.integers(0, n - 1)), max_size=90),
+        )
+    )
+)
 def test_components_match_scipy_and_label_by_the_smallest_item(case):
     n, pairs = case
     a = np.array([p[0] for p in pairs], dtype=np.int64)
@@ -64,9 +71,13 @@ def test_triangle_components_of_separate_pieces(checked):
 
 def test_pieces_cut_at_segments(checked):
     # a line across a rectangle and a closed inner square: three pieces, one component
-    dom = GeometryCollection([box(0, 0, 3, 1), LineString([(1, 0), (1, 1)]),
-                              LineString([(2, 0.25), (2.5, 0.25), (2.5, 0.75), (2, 0.75),
-                                          (2, 0.25)])])
+    dom = GeometryCollection(
+        [
+            box(0, 0, 3, 1),
+            LineString([(1, 0), (1, 1)]),
+            LineString([(2, 0.25), (2.5, 0.25), (2.5, 0.75), (2, 0.75), (2, 0.25)]),
+        ]
+    )
     mesh = checked(aftmesh.generate(dom, size=0.2))
     assert triangle_components(mesh).max() == 0
     piece = triangle_components(mesh, cut_at_segments=True)
@@ -94,7 +105,8 @@ def test_hole_points_and_region_points(checked):
 
 
 def test_empty_mesh_topology():
-    mesh = aftmesh.Mesh(np.zeros((0, 2)), np.zeros((0, 3)), np.zeros((0, 3)),
-                        np.zeros((0, 2)), np.zeros(0))
+    mesh = aftmesh.Mesh(
+        np.zeros((0, 2)), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 2)), np.zeros(0)
+    )
     assert triangle_components(mesh).shape == (0,)
     assert hole_points(mesh).shape == (0, 2) and region_points(mesh).shape == (0, 3)

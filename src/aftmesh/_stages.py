@@ -4,6 +4,7 @@ Each stage is one step of ARCHITECTURE.md's data flow: the size field, the discr
 boundary and its CDT (with the retry policy for rounding), the kernel made ready for
 the front, the front itself, smoothing, and the :class:`~aftmesh.mesh.Mesh`.
 """
+
 from __future__ import annotations
 
 import sys
@@ -14,8 +15,7 @@ import numpy as np
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
-from .errors import (CrossingSegmentsError, InvalidDomainError, InvalidOptionError,
-                     InvalidSizeError)
+from .errors import CrossingSegmentsError, InvalidDomainError, InvalidOptionError, InvalidSizeError
 from .mesh import Mesh
 from .options import MAX_TRIANGLES, ORDERS, Options
 from .pslg import BuiltCDT, build_cdt
@@ -82,17 +82,18 @@ def expected_triangles(field: SizeField, area: float, gradation: float) -> float
     so one tiny feature does not make the estimate explode."""
     with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
         if field.h.size == 1:
-            return float(np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min))
-                         / field.h_min)
+            return float(
+                np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min)) / field.h_min
+            )
         h = field.h
         rate = max(gradation - 1.0, MIN_ESTIMATE_RATE)
         cell = field.dx * field.dy
         dense = cell / (EQUILATERAL_AREA * h) / h
         graded = (2 * np.pi / (EQUILATERAL_AREA * rate * rate)) * (
-            1.0 + np.log1p(rate * max(field.dx, field.dy) / h))
+            1.0 + np.log1p(rate * max(field.dx, field.dy) / h)
+        )
         grid_area = cell * h.size
-        return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area)
-                     * ESTIMATE_MARGIN)
+        return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area) * ESTIMATE_MARGIN)
 
 
 def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
@@ -124,7 +125,8 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
         raise InvalidSizeError(
             f"the size (down to {field.h_min:.3g}) asks for about {expected:.3g} triangles "
             f"on a domain of area {area:.3g}: more than the {MAX_TRIANGLES} aftmesh "
-            "can number")
+            "can number"
+        )
     return field, expected
 
 
@@ -135,7 +137,7 @@ class Boundary:
     built: BuiltCDT
     vertices: np.ndarray
     segments: np.ndarray
-    source: np.ndarray          # input edge of each segment (see Domain.segment_edge)
+    source: np.ndarray  # input edge of each segment (see Domain.segment_edge)
     triangle_hint: int
 
 
@@ -146,8 +148,9 @@ def _name_sources(err: CrossingSegmentsError, dom: Domain, verts, segs, edge):
     names = [dom.source_names[src[k]] for k in err.segments if 0 <= k < len(src)]
     where = [verts[segs[k]].tolist() for k in err.segments if 0 <= k < len(src)]
     detail = " and ".join(f"{n} (near {w[0]} -> {w[1]})" for n, w in zip(names, where))
-    return CrossingSegmentsError(f"these input edges cross: {detail}",
-                                 tuple(int(src[k]) for k in err.segments))
+    return CrossingSegmentsError(
+        f"these input edges cross: {detail}", tuple(int(src[k]) for k in err.segments)
+    )
 
 
 def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) -> Boundary:
@@ -164,28 +167,37 @@ def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) 
         # be meshed within N_max: refuse before allocating them (the exact minimum,
         # formula (3), is checked once the CDT exists)
         cap, limit = opts.triangle_cap
-        verts, segs, edge = discretize(dom.vertices, dom.segments, dom.segment_edge, field,
-                                       max_pieces=3 * cap, limit=limit)
+        verts, segs, edge = discretize(
+            dom.vertices, dom.segments, dom.segment_edge, field, max_pieces=3 * cap, limit=limit
+        )
     else:
         verts, segs, edge = dom.vertices, dom.segments, dom.segment_edge
     hint = int(min(MAX_TRIANGLE_HINT, expected + 4 * len(verts)))
 
     def build(verts, segs):
         try:
-            return build_cdt(verts, segs, dom.holes, dom.region_points, carve=True,
-                             nt_hint=min(hint, MAX_PREALLOCATED))
+            return build_cdt(
+                verts,
+                segs,
+                dom.holes,
+                dom.region_points,
+                carve=True,
+                nt_hint=min(hint, MAX_PREALLOCATED),
+            )
         except CrossingSegmentsError as err:
             return err
 
     built = build(verts, segs)
     if opts.split_boundary and (isinstance(built, CrossingSegmentsError) or built.n_split):
-        verts, segs, edge = discretize(dom.vertices, dom.segments, dom.segment_edge, field,
-                                       clear=snap_tolerance(dom.vertices))
+        verts, segs, edge = discretize(
+            dom.vertices, dom.segments, dom.segment_edge, field, clear=snap_tolerance(dom.vertices)
+        )
         dom.cleanup.append("left out split points within rounding of other segments")
         built = build(verts, segs)
     if isinstance(built, CrossingSegmentsError):
-        verts, segs, edge = node_crossings(verts, segs, edge, dom.cleanup,
-                                           ring_source=dom.edge_is_ring)
+        verts, segs, edge = node_crossings(
+            verts, segs, edge, dom.cleanup, ring_source=dom.edge_is_ring
+        )
         built = build(verts, segs)
         if isinstance(built, CrossingSegmentsError):
             raise _name_sources(built, dom, verts, segs, edge) from None
@@ -202,19 +214,25 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
     _, n_unmeshed, _ = kernel.state_counts()
     if n_unmeshed == 0:
         raise InvalidDomainError(
-            "the domain encloses no area (are the segments closed rings? are all regions holes?)")
+            "the domain encloses no area (are the segments closed rings? are all regions holes?)"
+        )
     if opts.max_triangles is not None and n_unmeshed > opts.max_triangles:
         raise InvalidSizeError(
             f"max_triangles={opts.max_triangles} is below the {n_unmeshed} triangles any "
-            "triangulation of this boundary needs (formula (3))")
+            "triangulation of this boundary needs (formula (3))"
+        )
     min_area = opts.min_area
     if min_area is None:
-        min_area = MIN_AREA_FRACTION * (np.sqrt(3) / 4) * field.h_min ** 2
+        min_area = MIN_AREA_FRACTION * (np.sqrt(3) / 4) * field.h_min**2
     kernel.set_size_grid(field.x0, field.y0, field.dx, field.dy, field.h)
-    kernel.set_options(order=ORDERS[opts.order],
-                       max_triangles=-1 if opts.max_triangles is None else opts.max_triangles,
-                       min_area=float(min_area), close_factor=opts.close_factor,
-                       swaps=opts.swaps, greedy=opts.greedy)
+    kernel.set_options(
+        order=ORDERS[opts.order],
+        max_triangles=-1 if opts.max_triangles is None else opts.max_triangles,
+        min_area=float(min_area),
+        close_factor=opts.close_factor,
+        swaps=opts.swaps,
+        greedy=opts.greedy,
+    )
     return kernel
 
 
@@ -230,11 +248,12 @@ def run_front(kernel, opts: Options, triangle_hint: int) -> None:
             if isinstance(bar, _ProgressBar):
                 bar.close()
         return
-    assert opts.strategy is not None     # the compiled loop returned above otherwise
+    assert opts.strategy is not None  # the compiled loop returned above otherwise
     basic_aft(kernel, opts.strategy)
     if kernel.counters()["unmeshed"] != 0:
         raise InvalidOptionError(
-            "the strategy's get_next_edge returned -1 while front edges remained")
+            "the strategy's get_next_edge returned -1 while front edges remained"
+        )
 
 
 def smooth(kernel, boundary: Boundary, rounds: int) -> int:
@@ -243,14 +262,22 @@ def smooth(kernel, boundary: Boundary, rounds: int) -> int:
     return kernel.smooth(len(boundary.vertices), rounds) if rounds else 0
 
 
-def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Options,
-             moves: int, timing: dict, edge_tags=None) -> Mesh:
+def assemble(
+    kernel,
+    boundary: Boundary,
+    dom: Domain,
+    field: SizeField,
+    opts: Options,
+    moves: int,
+    timing: dict,
+    edge_tags=None,
+) -> Mesh:
     """The Mesh: the kernel's compact arrays; for each segment its input edge
     (segment_sources), its marker (the user's ring / line / segment it lies on, or
     that source's own marker) and its boundary tag; and what happened."""
     built = boundary.built
     a = kernel.arrays()
-    pieces = a["segment_ids"]     # the kernel's provenance of each output segment
+    pieces = a["segment_ids"]  # the kernel's provenance of each output segment
     edges = np.where(pieces >= 0, boundary.source[np.maximum(pieces, 0)], -1).astype(np.int32)
     markers = np.where(edges >= 0, dom.edge_source[np.maximum(edges, 0)], -1).astype(np.int32)
     if dom.source_markers is not None:
@@ -273,9 +300,18 @@ def assemble(kernel, boundary: Boundary, dom: Domain, field: SizeField, opts: Op
     tags, names = None, {}
     if edge_tags is not None:
         tags, names = segment_tags(edge_tags[0], edges), edge_tags[1]
-    return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
-                       segments=a["segments"], regions=a["regions"], segment_markers=markers,
-                       segment_sources=edges, segment_tags=tags, tag_names=names, info=info)
+    return Mesh._adopt(
+        points=a["points"],
+        triangles=a["triangles"],
+        neighbors=a["neighbors"],
+        segments=a["segments"],
+        regions=a["regions"],
+        segment_markers=markers,
+        segment_sources=edges,
+        segment_tags=tags,
+        tag_names=names,
+        info=info,
+    )
 
 
 def boundary_tags(dom: Domain, opts: Options):
@@ -284,5 +320,7 @@ def boundary_tags(dom: Domain, opts: Options):
     if opts.boundary_tags is None:
         return None
     return resolve_boundary_tags(
-        opts.boundary_tags, dom.edge_midpoints,
-        describe=lambda e: dom.source_names[dom.edge_source[e]])
+        opts.boundary_tags,
+        dom.edge_midpoints,
+        describe=lambda e: dom.source_names[dom.edge_source[e]],
+    )

@@ -4,6 +4,7 @@ Each mirrors a named ``cdef enum`` of ``cython_ext/halfedge.pxd``; the kernel
 exports the same names and values as ``_kernel.*_VALUES`` dicts and
 ``tests/test_states.py`` checks that the two agree, so neither side can drift.
 """
+
 from __future__ import annotations
 
 from enum import IntEnum, IntFlag
@@ -14,10 +15,10 @@ __all__ = ["EdgeFlag", "Location", "Order", "TriangleState"]
 class TriangleState(IntEnum):
     """``tstate`` of a triangle slot (``TriState`` in the kernel)."""
 
-    FREE = 0          # slot not in use (only inside a re-triangulation)
-    EXTERIOR = 1      # ghost triangles, outside the domain, holes
-    UNMESHED = 2      # the unmeshed region S(E) of the paper
-    MESHED = 3        # the mesh T built so far
+    FREE = 0  # slot not in use (only inside a re-triangulation)
+    EXTERIOR = 1  # ghost triangles, outside the domain, holes
+    UNMESHED = 2  # the unmeshed region S(E) of the paper
+    MESHED = 3  # the mesh T built so far
 
 
 class Order(IntEnum):
@@ -40,5 +41,5 @@ class Location(IntEnum):
 class EdgeFlag(IntFlag):
     """Bits of a half-edge's ``eflag`` (``EdgeFlag`` in the kernel)."""
 
-    SEGMENT = 1       # an input edge: never flipped
-    FIXED = 2         # a temporary constraint (Update_internal's F, G)
+    SEGMENT = 1  # an input edge: never flipped
+    FIXED = 2  # a temporary constraint (Update_internal's F, G)

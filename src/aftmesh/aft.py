@@ -3,10 +3,11 @@
 The loop below reads like the paper's Figure 5 and calls the kernel's primitives.  A
 :class:`Strategy` supplies the five subtasks a user may replace (Get_next_edge,
 Compute_new_candidate, New_is_preferred and its proximity rule ``is_crowded``,
-Mesh_size_constraint); the kernel supplies the ones that keep the frontal edge set and the CDT consistent (Compute_existing_candidate,
-Check_visible, Update_internal, Update_boundary, Add_triangle).  When no subtask is
-overridden, :func:`aftmesh.generate` runs the same algorithm as one compiled loop
-without the GIL instead; both give the identical mesh.
+Mesh_size_constraint); the kernel supplies the ones that keep the frontal edge set
+and the CDT consistent (Compute_existing_candidate, Check_visible, Update_internal,
+Update_boundary, Add_triangle).  When no subtask is overridden,
+:func:`aftmesh.generate` runs the same algorithm as one compiled loop without the GIL
+instead; both give the identical mesh.
 
 In the CDT representation R can be refused but not forced: Check_visible answers
 "not visible" unless S lies outside the circumcircle of T(E, R) (Lemma 3.1), the

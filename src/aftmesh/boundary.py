@@ -6,6 +6,7 @@ cut into n pieces, n being the rounded integral of 1/h along it, with the cut po
 spaced so that every piece holds an equal share of that integral (shorter pieces where
 the size is smaller).  Segments shorter than the local size are kept whole.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -20,9 +21,15 @@ _SAMPLES = 32
 _FLAT = 1e-9
 
 
-def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
-               field: SizeField, max_pieces: int | None = None, limit: str = "",
-               clear: float = 0.0):
+def discretize(
+    vertices: np.ndarray,
+    segments: np.ndarray,
+    source: np.ndarray,
+    field: SizeField,
+    max_pieces: int | None = None,
+    limit: str = "",
+    clear: float = 0.0,
+):
     """Return (vertices, segments, source) with long segments split by the size.
 
     Raises InvalidSizeError, before allocating anything, if the boundary alone would
@@ -51,16 +58,19 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
     h0 = h[:, :-1]
     h1 = h[:, 1:]
     with np.errstate(divide="ignore", invalid="ignore"):
-        log_mean = np.where(np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0),
-                            2.0 / (h0 + h1))
+        log_mean = np.where(
+            np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0), 2.0 / (h0 + h1)
+        )
     steps = ds * log_mean
     cum = np.concatenate([np.zeros((len(segments), 1)), np.cumsum(steps, axis=1)], axis=1)
     total = float(np.rint(cum[:, -1]).clip(min=1).sum())
     if max_pieces is not None and not total <= max_pieces:
         from .errors import InvalidSizeError
+
         raise InvalidSizeError(
             f"{limit} is below what the boundary alone needs: about {total:.3g} edges at "
-            "this size (each a side of a different triangle but for a few)")
+            "this size (each a side of a different triangle but for a few)"
+        )
     pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
     split = np.flatnonzero(pieces > 1)
     points = []
@@ -93,25 +103,28 @@ def discretize(vertices: np.ndarray, segments: np.ndarray, source: np.ndarray,
         new_vertices.append(pts)
         new_segments.append(np.c_[chain[:-1], chain[1:]])
         new_source.append(np.full(m + 1, source[k]))
-    return (np.concatenate(new_vertices), np.concatenate(new_segments).astype(np.int32),
-            np.concatenate(new_source).astype(np.int32))
+    return (
+        np.concatenate(new_vertices),
+        np.concatenate(new_segments).astype(np.int32),
+        np.concatenate(new_source).astype(np.int32),
+    )
 
 
 def _clear_of_others(points, split, a, b, clear):
     """Drop from points[i] (the split points of segment split[i]) those within
     `clear` of any other segment."""
     import shapely
+
     lines = shapely.linestrings(np.stack([a, b], axis=1))
     allp = np.concatenate(points)
     parent = np.repeat(split, [len(p) for p in points])
-    pi, si = shapely.STRtree(lines).query(shapely.points(allp), predicate="dwithin",
-                                          distance=clear)
+    pi, si = shapely.STRtree(lines).query(shapely.points(allp), predicate="dwithin", distance=clear)
     keep = np.ones(len(allp), dtype=bool)
     keep[pi[si != parent[pi]]] = False
     out = []
     start = 0
     for p in points:
-        out.append(p[keep[start:start + len(p)]])
+        out.append(p[keep[start : start + len(p)]])
         start += len(p)
     return out
 
@@ -121,12 +134,15 @@ def _keep_sides(points, split, vertices, segments, clear):
     segment is on the same side of each nearby piece as of the segment (decided by
     the exact orientation predicate; the segment itself, unsplit, always qualifies)."""
     import shapely
+
     from ._kernel import py_orient2d
+
     a = vertices[segments[split, 0]]
     b = vertices[segments[split, 1]]
     lines = shapely.linestrings(np.stack([a, b], axis=1))
-    vi, li = shapely.STRtree(lines).query(shapely.points(vertices), predicate="dwithin",
-                                          distance=clear)
+    vi, li = shapely.STRtree(lines).query(
+        shapely.points(vertices), predicate="dwithin", distance=clear
+    )
     out = list(points)
     for v, i in zip(vi.tolist(), li.tolist()):
         k = int(split[i])
@@ -135,8 +151,8 @@ def _keep_sides(points, split, vertices, segments, clear):
         pv = vertices[v]
         side = py_orient2d(a[i, 0], a[i, 1], b[i, 0], b[i, 1], pv[0], pv[1])
         if side == 0:
-            continue        # on the segment: the CDT splits it there, as it would unsplit
-        pts = out[i]            # lines[i] is segment split[i], whose points are points[i]
+            continue  # on the segment: the CDT splits it there, as it would unsplit
+        pts = out[i]  # lines[i] is segment split[i], whose points are points[i]
         changed = True
         while changed and len(pts):
             changed = False

@@ -1,5 +1,6 @@
 """``aftmesh.cdt``: the constrained Delaunay triangulation of a PSLG, no points added
 (unless crossing segments are to be split at their crossing points)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -76,13 +77,14 @@ def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise")
     """
     if not isinstance(crossings, str) or crossings not in CROSSINGS:
         raise InvalidOptionError(
-            f"crossings={crossings!r} is not a valid option, must be one of {list(CROSSINGS)}")
+            f"crossings={crossings!r} is not a valid option, must be one of {list(CROSSINGS)}"
+        )
     noded = _split_crossings(vertices, segments) if crossings == "split" else None
     if noded is None:
         built = build_cdt(vertices, segments, holes, regions)
         a = built.kernel.arrays()
         to_out = a["vertex_map"][built.merged]
-        markers = a["segment_ids"]     # the kernel's provenance of each output segment
+        markers = a["segment_ids"]  # the kernel's provenance of each output segment
         info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
         if crossings == "split":
             info["crossings"] = _no_crossings()
@@ -93,11 +95,21 @@ def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise")
         noded_out = a["vertex_map"][built.merged]
         ids = a["segment_ids"]
         markers = np.where(ids >= 0, src[np.maximum(ids, 0)], -1).astype(np.int32)
-        info = {"merged_vertices": n_merged, "vertex_map": noded_out[to_noded],
-                "crossings": _crossing_report(verts, segs, src, to_noded, noded_out)}
-    return Mesh._adopt(points=a["points"], triangles=a["triangles"], neighbors=a["neighbors"],
-                       segments=a["segments"], regions=a["regions"], segment_markers=markers,
-                       segment_sources=markers, info=info)
+        info = {
+            "merged_vertices": n_merged,
+            "vertex_map": noded_out[to_noded],
+            "crossings": _crossing_report(verts, segs, src, to_noded, noded_out),
+        }
+    return Mesh._adopt(
+        points=a["points"],
+        triangles=a["triangles"],
+        neighbors=a["neighbors"],
+        segments=a["segments"],
+        regions=a["regions"],
+        segment_markers=markers,
+        segment_sources=markers,
+        info=info,
+    )
 
 
 def _split_crossings(vertices, segments):
@@ -119,8 +131,13 @@ def _split_crossings(vertices, segments):
     index = {p: i for i, p in enumerate(map(tuple, verts.tolist()))}
     to_noded = np.array([index[p] for p in map(tuple, pts.tolist())], dtype=np.int64)
     n_merged = len(pts) - len(np.unique(to_noded))
-    return (np.ascontiguousarray(verts), np.asarray(segs, dtype=np.int32),
-            np.asarray(src, dtype=np.int32), to_noded, n_merged)
+    return (
+        np.ascontiguousarray(verts),
+        np.asarray(segs, dtype=np.int32),
+        np.asarray(src, dtype=np.int32),
+        to_noded,
+        n_merged,
+    )
 
 
 def _no_crossings():
@@ -138,6 +155,8 @@ def _crossing_report(verts, segs, src, to_noded, noded_out):
             if is_new[v]:
                 through.setdefault(v, set()).add(s)
     new = np.flatnonzero(is_new)
-    return {"points": verts[new].copy(),
-            "segments": [tuple(sorted(through.get(int(v), ()))) for v in new],
-            "vertices": noded_out[new].astype(np.int32)}
+    return {
+        "points": verts[new].copy(),
+        "segments": [tuple(sorted(through.get(int(v), ()))) for v in new],
+        "vertices": noded_out[new].astype(np.int32),
+    }

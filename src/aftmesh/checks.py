@@ -13,6 +13,7 @@
 
 It raises :class:`MeshCheckError` listing every problem found.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -37,9 +38,15 @@ def _edges(tri: np.ndarray):
     return a, b
 
 
-def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
-               input_segments: np.ndarray | None = None, delaunay: bool = True,
-               boundary_is_segments: bool | None = None, area_rtol: float = 1e-9) -> None:
+def check_mesh(
+    mesh: Mesh,
+    *,
+    domain_area: float | None = None,
+    input_segments: np.ndarray | None = None,
+    delaunay: bool = True,
+    boundary_is_segments: bool | None = None,
+    area_rtol: float = 1e-9,
+) -> None:
     """Check every invariant of ``mesh``; raise :class:`MeshCheckError` if any fails.
 
     Parameters
@@ -91,8 +98,10 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
     orient = _kernel.orient2d_many(np.ascontiguousarray(P), np.ascontiguousarray(T))
     if (orient <= 0).any():
         i = int(np.flatnonzero(orient <= 0)[0])
-        problems.append(f"{int((orient <= 0).sum())} triangles not counter-clockwise, e.g. {i}: "
-                        f"{P[T[i]].tolist()}")
+        problems.append(
+            f"{int((orient <= 0).sum())} triangles not counter-clockwise, e.g. {i}: "
+            f"{P[T[i]].tolist()}"
+        )
     # topology: match each half-edge with its reverse
     a, b = _edges(T)
     key = a.astype(np.int64) * n + b
@@ -109,8 +118,10 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
     neighbors_ok = np.array_equal(other, N)
     if not neighbors_ok:
         bad = np.argwhere(other != N)[0]
-        problems.append(f"neighbors[{bad[0]}, {bad[1]}] = {N[bad[0], bad[1]]}, "
-                        f"the shared edge says {other[bad[0], bad[1]]}")
+        problems.append(
+            f"neighbors[{bad[0]}, {bad[1]}] = {N[bad[0], bad[1]]}, "
+            f"the shared edge says {other[bad[0], bad[1]]}"
+        )
     seg_keys = set()
     for u, v in S:
         seg_keys.add((int(u), int(v)))
@@ -118,7 +129,7 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
     boundary = ~found.reshape(t, 3)
     if boundary_is_segments is None:
         boundary_is_segments = len(S) > 0
-    for ti, k in (np.argwhere(boundary) if boundary_is_segments else ()):
+    for ti, k in np.argwhere(boundary) if boundary_is_segments else ():
         e = (int(a[ti, k]), int(b[ti, k]))
         if e not in seg_keys:
             problems.append(f"boundary edge {e} of triangle {ti} is not a segment")
@@ -130,12 +141,16 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
             break
     # area
     p = P[T]
-    area = 0.5 * ((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                  - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    area = 0.5 * (
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
     if domain_area is not None:
         total = float(area.sum())
         if abs(total - domain_area) > area_rtol * max(abs(domain_area), 1e-300) + 1e-300:
-            problems.append(f"triangle areas sum to {total!r}, the domain's area is {domain_area!r}")
+            problems.append(
+                f"triangle areas sum to {total!r}, the domain's area is {domain_area!r}"
+            )
     # conformity: each input segment covered by collinear mesh segments of equal total length
     if input_segments is not None and len(input_segments):
         problems.extend(_check_cover(P, S, np.asarray(input_segments, dtype=np.float64)))
@@ -145,8 +160,11 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         N = other
         interior = found.reshape(t, 3)
         ti, k = np.nonzero(interior)
-        is_seg = np.fromiter(((int(a[i, j]), int(b[i, j])) in seg_keys for i, j in zip(ti, k)),
-                             dtype=bool, count=len(ti))
+        is_seg = np.fromiter(
+            ((int(a[i, j]), int(b[i, j])) in seg_keys for i, j in zip(ti, k)),
+            dtype=bool,
+            count=len(ti),
+        )
         ti, k = ti[~is_seg], k[~is_seg]
         nb = N[ti, k]
         # the vertex of the neighbour not on the shared edge
@@ -156,8 +174,10 @@ def check_mesh(mesh: Mesh, *, domain_area: float | None = None,
         inc = _kernel.incircle_many(np.ascontiguousarray(P), quad)
         if (inc > 0).any():
             i = int(np.flatnonzero(inc > 0)[0])
-            problems.append(f"{int((inc > 0).sum())} non-Delaunay edges, e.g. triangle "
-                            f"{int(ti[i])} vs its neighbour {int(nb[i])}")
+            problems.append(
+                f"{int((inc > 0).sum())} non-Delaunay edges, e.g. triangle "
+                f"{int(ti[i])} vs its neighbour {int(nb[i])}"
+            )
     if problems:
         raise MeshCheckError("; ".join(problems))
 
@@ -174,11 +194,18 @@ def _check_cover(P, S, segs):
         cb = _kernel_orient_points(pa, pb, sb)
         ta = (sa - pa) @ d / (d @ d)
         tb = (sb - pa) @ d / (d @ d)
-        on = (ca == 0) & (cb == 0) & (np.minimum(ta, tb) >= -1e-12) & (np.maximum(ta, tb) <= 1 + 1e-12)
+        on = (
+            (ca == 0)
+            & (cb == 0)
+            & (np.minimum(ta, tb) >= -1e-12)
+            & (np.maximum(ta, tb) <= 1 + 1e-12)
+        )
         covered = float(np.hypot(*(sb[on] - sa[on]).T).sum())
         if abs(covered - L) > 1e-9 * max(L, 1e-300):
-            problems.append(f"input segment {j} ({pa.tolist()} -> {pb.tolist()}) is covered over "
-                            f"{covered!r} of its length {L!r}")
+            problems.append(
+                f"input segment {j} ({pa.tolist()} -> {pb.tolist()}) is covered over "
+                f"{covered!r} of its length {L!r}"
+            )
             break
     return problems
 

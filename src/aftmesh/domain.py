@@ -22,6 +22,7 @@ Clean-up done and reported in ``Mesh.info['cleanup']``: repeated vertices, a rep
 closing vertex, rings in either orientation, segments split at the vertices lying on
 them (or within rounding of them, see :func:`snap_tolerance`) and at their crossings.
 """
+
 from __future__ import annotations
 
 from .inputs import Domain, to_domain

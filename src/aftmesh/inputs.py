@@ -10,6 +10,7 @@ edges in coordinate order (edge i from coords[i] to coords[i + 1]), then the
 constraint lines' edges in order; for a dict or ``.poly`` file, the index in its
 ``segments``; for an (n, 2) ring, edge i from vertex i to vertex i + 1.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -17,12 +18,18 @@ from os import PathLike
 
 import numpy as np
 import shapely
-from shapely.geometry import (GeometryCollection, LineString, MultiLineString, MultiPoint,
-                              MultiPolygon, Point, Polygon)
+from shapely.geometry import (
+    GeometryCollection,
+    LineString,
+    MultiLineString,
+    MultiPoint,
+    MultiPolygon,
+    Point,
+    Polygon,
+)
 
 from .errors import InvalidDomainError, InvalidInputError
-from .noding import (merge_and_node, merge_close_segments, refuse_crossings,
-                     split_at_vertices)
+from .noding import merge_and_node, merge_close_segments, refuse_crossings, split_at_vertices
 from .pslg import as_points, as_segments, check_range
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
@@ -57,8 +64,8 @@ class Domain:
     region_points: np.ndarray | None = None
     area: float | None = None
     cleanup: list[str] = field(default_factory=list)
-    source_markers: np.ndarray | None = None    # the user's marker of each source
-    edge_midpoints: np.ndarray | None = None    # (e, 2) the midpoint of each input edge
+    source_markers: np.ndarray | None = None  # the user's marker of each source
+    edge_midpoints: np.ndarray | None = None  # (e, 2) the midpoint of each input edge
     report: dict = field(default_factory=dict)  # what repair / tolerance changed
 
     @property
@@ -81,8 +88,15 @@ class _Chains:
         self.n_vertices = 0
         self.n_edges = 0
 
-    def add(self, coords: np.ndarray, edge_ids: np.ndarray, n_edges: int, closed: bool,
-            name: str, midpoints: np.ndarray) -> None:
+    def add(
+        self,
+        coords: np.ndarray,
+        edge_ids: np.ndarray,
+        n_edges: int,
+        closed: bool,
+        name: str,
+        midpoints: np.ndarray,
+    ) -> None:
         """Add one ring or line: `coords` cleaned, `edge_ids[i]` the input edge (within
         this chain, of `n_edges`) from coords[i] to the next vertex."""
         n = len(coords)
@@ -96,7 +110,7 @@ class _Chains:
             seg = np.c_[idx, (idx + 1) % n] if closed else np.c_[idx[:-1], idx[1:]]
             self.vertices.append(coords)
             self.segments.append(seg + self.n_vertices)
-            self.edge_ids.append(np.asarray(edge_ids[:len(seg)]) + self.n_edges)
+            self.edge_ids.append(np.asarray(edge_ids[: len(seg)]) + self.n_edges)
             self.n_vertices += n
         self.n_edges += n_edges
 
@@ -134,14 +148,21 @@ def _line_chain(coords: np.ndarray):
     return c[keep], np.flatnonzero(keep), max(len(c) - 1, 0), mid
 
 
-def _from_shapely(polygons: list[Polygon], lines: list, line_names: list[str],
-                  points: list, names: list[str], tolerance: float = 0.0) -> Domain:
+def _from_shapely(
+    polygons: list[Polygon],
+    lines: list,
+    line_names: list[str],
+    points: list,
+    names: list[str],
+    tolerance: float = 0.0,
+) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain."""
     note: list[str] = []
     chains = _Chains()
     for k, poly in enumerate(polygons):
         rings = [("exterior ring", poly.exterior)] + [
-            (f"hole {i}", h) for i, h in enumerate(poly.interiors)]
+            (f"hole {i}", h) for i, h in enumerate(poly.interiors)
+        ]
         for rname, ring in rings:
             name = f"{names[k]}, {rname}"
             c, ids, n_edges, mid = _ring_chain(np.asarray(ring.coords)[:, :2], note, name)
@@ -154,17 +175,27 @@ def _from_shapely(polygons: list[Polygon], lines: list, line_names: list[str],
     verts = np.concatenate(chains.vertices) if chains.vertices else np.zeros((0, 2))
     segs = np.concatenate(chains.segments) if chains.segments else np.zeros((0, 2), np.int64)
     edges = np.concatenate(chains.edge_ids) if chains.edge_ids else np.zeros(0, np.int64)
-    edge_source = (np.concatenate(chains.edge_source) if chains.edge_source
-                   else np.zeros(0, np.int64)).astype(np.int32)
+    edge_source = (
+        np.concatenate(chains.edge_source) if chains.edge_source else np.zeros(0, np.int64)
+    ).astype(np.int32)
     is_ring = np.asarray(chains.is_ring, dtype=bool)[edge_source]
     report: dict = {}
     verts, segs, edges = merge_and_node(verts, segs, edges, note, is_ring, tolerance, report)
     union_area = float(shapely.union_all(polygons).area)
     mids = np.concatenate(chains.midpoints) if chains.midpoints else np.zeros((0, 2))
-    return Domain(verts, segs.astype(np.int32), edges.astype(np.int32), edge_source,
-                  chains.names, edge_is_ring=is_ring, polygons=polygons, area=union_area,
-                  cleanup=note, edge_midpoints=mids,
-                  report={"tolerance": report} if report else {})
+    return Domain(
+        verts,
+        segs.astype(np.int32),
+        edges.astype(np.int32),
+        edge_source,
+        chains.names,
+        edge_is_ring=is_ring,
+        polygons=polygons,
+        area=union_area,
+        cleanup=note,
+        edge_midpoints=mids,
+        report={"tolerance": report} if report else {},
+    )
 
 
 def _dict_regions(regions):
@@ -173,7 +204,9 @@ def _dict_regions(regions):
     try:
         reg = np.asarray(regions, dtype=np.float64)
     except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"regions must be rows of (x, y, marker[, max_area]): {exc}") from None
+        raise InvalidInputError(
+            f"regions must be rows of (x, y, marker[, max_area]): {exc}"
+        ) from None
     if reg.size == 0:
         return None
     if reg.ndim != 2 or reg.shape[1] < 3:
@@ -190,14 +223,16 @@ def _dict_markers(markers, n_segments: int):
         raise InvalidInputError(f"segment_markers must be a list of integers: {exc}") from None
     if len(markers) != n_segments:
         raise InvalidInputError(
-            f"segment_markers has {len(markers)} entries for {n_segments} segments")
+            f"segment_markers has {len(markers)} entries for {n_segments} segments"
+        )
     if not np.issubdtype(markers.dtype, np.integer):
         raise InvalidInputError("segment_markers must be integers")
     big = np.abs(markers.astype(np.int64)) > 2**31 - 1
     if big.any():
         i = int(np.flatnonzero(big)[0])
         raise InvalidInputError(
-            f"segment_markers[{i}] = {int(markers[i])} is out of the int32 range")
+            f"segment_markers[{i}] = {int(markers[i])} is out of the int32 range"
+        )
     return markers.astype(np.int32)
 
 
@@ -217,23 +252,32 @@ def from_dict(d: dict, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     note: list[str] = []
     report = {"merged": 0, "snapped": 0}
     if tolerance > 0:
-        pts, seg, edges, report["merged"] = merge_close_segments(pts, seg, edges, note,
-                                                                 tolerance)
+        pts, seg, edges, report["merged"] = merge_close_segments(pts, seg, edges, note, tolerance)
     refuse_crossings(pts, seg)
     # a segment running exactly through another vertex is split there now, before the
     # size splits it into pieces whose rounded ends would miss that vertex (kept whole,
     # the CDT splits it there exactly, at no cost here)
     if presplit or tolerance > 0:
         seg, edges = split_at_vertices(pts, seg, edges, note, tolerance, None, report)
-    return Domain(pts, np.asarray(seg, dtype=np.int32), np.asarray(edges, dtype=np.int32),
-                  np.arange(len(names), dtype=np.int32), names, holes=holes,
-                  region_points=reg, source_markers=markers, cleanup=note,
-                  edge_midpoints=mids, report={"tolerance": report} if tolerance > 0 else {})
+    return Domain(
+        pts,
+        np.asarray(seg, dtype=np.int32),
+        np.asarray(edges, dtype=np.int32),
+        np.arange(len(names), dtype=np.int32),
+        names,
+        holes=holes,
+        region_points=reg,
+        source_markers=markers,
+        cleanup=note,
+        edge_midpoints=mids,
+        report={"tolerance": report} if tolerance > 0 else {},
+    )
 
 
 def from_poly_file(path, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     """A Triangle ``.poly`` file: read into a dict, then as :func:`from_dict`."""
     from .io import read_poly
+
     try:
         d = read_poly(path)
     except OSError as exc:
@@ -254,9 +298,11 @@ def _split_geometry(domain):
             pieces = list(shapely.get_parts(part))
             for j, piece in enumerate(pieces):
                 lines.append(piece)
-                line_names.append(f"constraint line {n_lines}" if len(pieces) == 1
-                                  or isinstance(part, LineString)
-                                  else f"part {j} of constraint line {n_lines}")
+                line_names.append(
+                    f"constraint line {n_lines}"
+                    if len(pieces) == 1 or isinstance(part, LineString)
+                    else f"part {j} of constraint line {n_lines}"
+                )
             n_lines += 1
         elif isinstance(part, (Point, MultiPoint)):
             points.extend(shapely.get_parts(part))
@@ -271,8 +317,7 @@ def from_geometry(domain, tolerance: float = 0.0) -> Domain:
     polygons, lines, line_names, points = _split_geometry(domain)
     if not polygons:
         raise InvalidDomainError("the domain has no polygon to mesh")
-    names = [f"polygon {k}" if len(polygons) > 1 else "the polygon"
-             for k in range(len(polygons))]
+    names = [f"polygon {k}" if len(polygons) > 1 else "the polygon" for k in range(len(polygons))]
     for k, p in enumerate(polygons):
         check_polygon(p, names[k])
     check_lines_inside(polygons, lines, line_names, points, tolerance)
@@ -325,7 +370,8 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
             if overlap > REGION_OVERLAP * min(polygons[i].area, polygons[j].area):
                 raise InvalidDomainError(
                     f"regions {i} and {j} overlap (common area {overlap:.6g}): regions must "
-                    "have disjoint interiors")
+                    "have disjoint interiors"
+                )
     flat: list[Polygon] = []
     names: list[str] = []
     for k, p in enumerate(polygons):
@@ -356,8 +402,9 @@ def polygon_parts(geom, where: str) -> list[Polygon]:
     raise InvalidDomainError(f"{where} is a {geom.geom_type}, expected a Polygon")
 
 
-def to_domain(domain, *, keep_vertices: bool = False, tolerance: float = 0.0,
-              repair: bool = False) -> Domain:
+def to_domain(
+    domain, *, keep_vertices: bool = False, tolerance: float = 0.0, repair: bool = False
+) -> Domain:
     """Convert any accepted domain form into a :class:`Domain` (see
     :mod:`aftmesh.domain`).  `keep_vertices` keeps a dict's segments unsplit (the CDT
     splits them exactly); `tolerance` merges vertices closer than it and snaps line
@@ -388,5 +435,6 @@ def _dispatch(domain, keep_vertices: bool, tolerance: float) -> Domain:
     except TypeError:
         raise InvalidDomainError(
             f"cannot mesh a {type(domain).__name__}: give a shapely geometry, a sequence of "
-            "polygons, an (n, 2) array, a dict or a .poly path") from None
+            "polygons, an (n, 2) array, a dict or a .poly path"
+        ) from None
     return from_regions(items, tolerance)

@@ -8,6 +8,7 @@
 * :func:`read_wkt` / :func:`read_geojson`: a shapely geometry from a text file, in
   :mod:`aftmesh.io_gis`.
 """
+
 from __future__ import annotations
 
 from .io_gis import read_geojson, read_wkt
@@ -15,11 +16,11 @@ from .io_mesh import gmsh_physical_groups, mesh_format, write_mesh
 from .io_poly import read_poly, write_poly
 
 __all__ = [
-           "gmsh_physical_groups",
-           "mesh_format",
-           "read_geojson",
-           "read_poly",
-           "read_wkt",
-           "write_mesh",
-           "write_poly",
+    "gmsh_physical_groups",
+    "mesh_format",
+    "read_geojson",
+    "read_poly",
+    "read_wkt",
+    "write_mesh",
+    "write_poly",
 ]

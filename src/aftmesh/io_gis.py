@@ -1,4 +1,5 @@
 """Domains from GIS text formats: a shapely geometry from a WKT or GeoJSON file."""
+
 from __future__ import annotations
 
 from os import PathLike
@@ -39,6 +40,7 @@ def read_wkt(path: PathArg):
     0.5
     """
     import shapely
+
     path, text = _read_text(path, "a WKT geometry")
     try:
         geom = shapely.from_wkt(text.strip())
@@ -66,6 +68,7 @@ def read_geojson(path: PathArg):
     1.0
     """
     import shapely
+
     path, text = _read_text(path, "a GeoJSON object")
     try:
         geom = shapely.from_geojson(text)

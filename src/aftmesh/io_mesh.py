@@ -22,6 +22,7 @@ holds mixed cells (:data:`LINE_FORMATS`), so a solver finds its boundary parts:
   ``segment_marker`` (-1 on triangles) and, when the mesh has them, ``segment_tag``
   (0 on triangles) and ``segment_source`` (-1 on triangles).
 """
+
 from __future__ import annotations
 
 from os import PathLike
@@ -53,7 +54,9 @@ def _import_meshio(path: Path):
     except ImportError:
         raise ModuleNotFoundError(
             f"writing {path.name!r} needs meshio: pip install aftmesh[io] (without it, "
-            "write .poly or .node/.ele)", name="meshio") from None
+            "write .poly or .node/.ele)",
+            name="meshio",
+        ) from None
     return meshio
 
 
@@ -153,8 +156,10 @@ def _cells_and_data(mesh, fmt: str):
         # medit keeps one integer reference per cell: the first integer cell data
         cell_data["medit:ref"] = [region, np.asarray(mesh.segment_markers, dtype=np.int32)]
     cell_data["region"] = [region, np.full(s, -1, dtype=np.int32)]
-    cell_data["segment_marker"] = [np.full(t, -1, dtype=np.int32),
-                                   np.asarray(mesh.segment_markers, dtype=np.int32)]
+    cell_data["segment_marker"] = [
+        np.full(t, -1, dtype=np.int32),
+        np.asarray(mesh.segment_markers, dtype=np.int32),
+    ]
     tags = _optional(mesh, "segment_tags", s)
     if tags is not None:
         cell_data["segment_tag"] = [np.zeros(t, dtype=np.int32), tags]
@@ -166,8 +171,10 @@ def _cells_and_data(mesh, fmt: str):
         # the physical groups and their names say it all; meshio reads element data
         # of a file with two cell blocks back wrongly, so none is written
         tri_tags, seg_tags, field_data = gmsh_physical_groups(mesh)
-        cell_data = {"gmsh:physical": [tri_tags, seg_tags],
-                     "gmsh:geometrical": [tri_tags, seg_tags]}
+        cell_data = {
+            "gmsh:physical": [tri_tags, seg_tags],
+            "gmsh:geometrical": [tri_tags, seg_tags],
+        }
     cells = [("triangle", triangles), ("line", np.asarray(mesh.segments))]
     return cells, cell_data, field_data
 
@@ -234,8 +241,8 @@ def write_mesh(mesh, path: PathArg, file_format: str | None = None) -> None:
     except ModuleNotFoundError as exc:
         # meshio imports a format's own dependency (h5py for XDMF) only when writing
         raise ModuleNotFoundError(
-            f"writing {path.name!r} needs {exc.name}: pip install aftmesh[io]",
-            name=exc.name) from None
+            f"writing {path.name!r} needs {exc.name}: pip install aftmesh[io]", name=exc.name
+        ) from None
 
 
 def mesh_format(path: PathArg, file_format: str | None = None) -> str:
@@ -269,8 +276,11 @@ def mesh_format(path: PathArg, file_format: str | None = None) -> str:
         return file_format
     suffixes = [s.lower() for s in path.suffixes]
     double = "".join(suffixes[-2:])
-    ext = double if len(suffixes) >= 2 and double in meshio.extension_to_filetypes else \
-        (suffixes[-1] if suffixes else "")
+    ext = (
+        double
+        if len(suffixes) >= 2 and double in meshio.extension_to_filetypes
+        else (suffixes[-1] if suffixes else "")
+    )
     if ext == ".msh":
         # meshio lists ANSYS first for .msh; Gmsh is what nearly everyone means
         return "gmsh22"
@@ -279,4 +289,5 @@ def mesh_format(path: PathArg, file_format: str | None = None) -> str:
     known = sorted({".poly", ".node", ".ele", *meshio.extension_to_filetypes})
     raise InvalidInputError(
         f"cannot tell the mesh format from the file name {path.name!r}: use one of the "
-        f"extensions {', '.join(known)} or give file_format")
+        f"extensions {', '.join(known)} or give file_format"
+    )

@@ -6,6 +6,7 @@ Triangle's formats number vertices from 0 or from 1: the first vertex's number d
 for the whole file (and for the segments of a ``.poly`` whose vertices are in a
 ``.node`` file).  aftmesh writes them numbered from 1, as Triangle itself does.
 """
+
 from __future__ import annotations
 
 from os import PathLike
@@ -19,6 +20,7 @@ from .topology import hole_points, region_points
 __all__ = ["read_poly", "write_mesh_poly", "write_node_ele", "write_poly"]
 
 PathArg = str | PathLike
+
 
 class _Fields:
     """The non-empty lines of a Triangle file, split into fields, with line numbers."""
@@ -71,19 +73,28 @@ class _Fields:
         """A line of ``what`` must have between ``least`` and ``most`` fields; too many
         usually means the count declared for the previous section is too small."""
         if len(fields) < least:
-            raise self.error(line, f"{what} needs {least} fields, got {len(fields)}: "
-                                   f"{' '.join(fields)!r}")
+            raise self.error(
+                line, f"{what} needs {least} fields, got {len(fields)}: {' '.join(fields)!r}"
+            )
         if len(fields) > most:
-            raise self.error(line, f"{what} has {len(fields)} fields, at most {most} "
-                                   f"expected: {' '.join(fields)!r} (is a count declared "
-                                   "earlier too small?)")
+            raise self.error(
+                line,
+                f"{what} has {len(fields)} fields, at most {most} "
+                f"expected: {' '.join(fields)!r} (is a count declared "
+                "earlier too small?)",
+            )
 
 
 def _read_vertex_section(f: _Fields):
     """Header line and vertex lines (the start of ``.node`` and ``.poly`` files)."""
     line, head = f.next("the vertex count line")
-    f.check_width(line, head, 1, 4, "the vertex count line "
-                  "(<# vertices> <dimension> <# attributes> <# boundary markers>)")
+    f.check_width(
+        line,
+        head,
+        1,
+        4,
+        "the vertex count line (<# vertices> <dimension> <# attributes> <# boundary markers>)",
+    )
     n = f.count(line, head[0], "the number of vertices")
     dim = f.integer(line, head[1], "the dimension") if len(head) > 1 else 2
     if dim != 2:
@@ -105,8 +116,11 @@ def _read_vertex_section(f: _Fields):
                 raise f.error(vline, f"the first vertex must be numbered 0 or 1, got {number}")
             base = number
         elif number != base + i:
-            raise f.error(vline, f"vertex number {number} out of sequence "
-                                 f"(expected {base + i}: vertices are numbered consecutively)")
+            raise f.error(
+                vline,
+                f"vertex number {number} out of sequence "
+                f"(expected {base + i}: vertices are numbered consecutively)",
+            )
         xy[i, 0] = f.number(vline, v[1], "x")
         xy[i, 1] = f.number(vline, v[2], "y")
         # Triangle reads missing attributes and markers as 0
@@ -184,7 +198,8 @@ def read_poly(path: PathArg) -> dict:
         if not vertex_file.exists():
             raise FileNotFoundError(
                 f"{path} declares 0 vertices, so they should be in {vertex_file}, "
-                "which does not exist")
+                "which does not exist"
+            )
         xy, attributes, vmarkers, base = _read_vertex_section(_Fields(vertex_file))
         if len(xy) == 0:
             raise InvalidInputError(f"{vertex_file}: the file has no vertices")
@@ -205,10 +220,13 @@ def read_poly(path: PathArg) -> dict:
         for k in (0, 1):
             v = f.integer(sline, s[1 + k], "a segment endpoint")
             if not base <= v < base + n:
-                raise f.error(sline, f"segment endpoint {v} is not a vertex "
-                                     f"(vertices are numbered {base}..{base + n - 1}"
-                                     + (f" in {vertex_file}" if vertex_file != path else "")
-                                     + ")")
+                raise f.error(
+                    sline,
+                    f"segment endpoint {v} is not a vertex "
+                    f"(vertices are numbered {base}..{base + n - 1}"
+                    + (f" in {vertex_file}" if vertex_file != path else "")
+                    + ")",
+                )
             segments[i, k] = v - base
         if segments[i, 0] == segments[i, 1]:
             raise f.error(sline, f"the segment joins vertex {s[1]} to itself")
@@ -236,12 +254,16 @@ def read_poly(path: PathArg) -> dict:
             regions[i, 1] = f.number(rline, r[2], "y")
             regions[i, 2] = f.number(rline, r[3], "the regional attribute")
             # as Triangle does, a lone value is both the attribute and the area bound
-            regions[i, 3] = f.number(rline, r[4], "the maximum area") if len(r) > 4 \
-                else regions[i, 2]
+            regions[i, 3] = (
+                f.number(rline, r[4], "the maximum area") if len(r) > 4 else regions[i, 2]
+            )
     if not f.at_end():
         line, extra = f.next("")
-        raise f.error(line, f"unexpected data after the last section: {' '.join(extra)!r} "
-                            "(is a count declared earlier too small?)")
+        raise f.error(
+            line,
+            f"unexpected data after the last section: {' '.join(extra)!r} "
+            "(is a count declared earlier too small?)",
+        )
 
     out = {"vertices": xy, "segments": segments, "holes": holes, "regions": regions}
     if attributes.shape[1]:
@@ -275,8 +297,9 @@ def _as_array(value, name: str, columns: int | tuple, dtype) -> np.ndarray:
     return arr
 
 
-def write_poly(path: PathArg, vertices, segments, holes=None, regions=None,
-               segment_markers=None) -> None:
+def write_poly(
+    path: PathArg, vertices, segments, holes=None, regions=None, segment_markers=None
+) -> None:
     """Write a planar straight-line graph as a Triangle ``.poly`` file.
 
     Parameters
@@ -312,10 +335,10 @@ def write_poly(path: PathArg, vertices, segments, holes=None, regions=None,
     if len(seg) and (seg.min() < 0 or seg.max() >= len(xy)):
         i = int(np.flatnonzero(((seg < 0) | (seg >= len(xy))).any(axis=1))[0])
         raise InvalidInputError(
-            f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{len(xy) - 1}")
+            f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{len(xy) - 1}"
+        )
     hl = _as_array(np.zeros((0, 2)) if holes is None else holes, "holes", 2, np.float64)
-    rg = _as_array(np.zeros((0, 4)) if regions is None else regions, "regions", (3, 4),
-                   np.float64)
+    rg = _as_array(np.zeros((0, 4)) if regions is None else regions, "regions", (3, 4), np.float64)
     if rg.shape[1] == 3:
         rg = np.c_[rg, np.full(len(rg), -1.0)]
     markers = None
@@ -323,7 +346,8 @@ def write_poly(path: PathArg, vertices, segments, holes=None, regions=None,
         markers = np.asarray(segment_markers).reshape(-1)
         if len(markers) != len(seg):
             raise InvalidInputError(
-                f"segment_markers has {len(markers)} entries for {len(seg)} segments")
+                f"segment_markers has {len(markers)} entries for {len(seg)} segments"
+            )
         if not np.issubdtype(markers.dtype, np.integer):
             if not np.array_equal(markers, np.round(markers)):
                 raise InvalidInputError("segment_markers must be integers")
@@ -348,8 +372,14 @@ def write_mesh_poly(mesh, path: Path) -> None:
     each piece enclosed by segments, so that meshing the file gives back the same
     holes and regions."""
     regions = region_points(mesh) if mesh.regions.any() else None
-    write_poly(path, mesh.points, mesh.segments, holes=hole_points(mesh),
-               regions=regions, segment_markers=mesh.segment_markers)
+    write_poly(
+        path,
+        mesh.points,
+        mesh.segments,
+        holes=hole_points(mesh),
+        regions=regions,
+        segment_markers=mesh.segment_markers,
+    )
 
 
 def write_node_ele(mesh, path: Path) -> None:
@@ -360,14 +390,22 @@ def write_node_ele(mesh, path: Path) -> None:
     ti, k = np.nonzero(mesh.neighbors < 0)
     on_boundary[T[ti, (k + 1) % 3]] = 1
     on_boundary[T[ti, (k + 2) % 3]] = 1
-    node = ["# written by aftmesh: vertex, x, y, boundary marker (1 on the boundary)",
-            f"{len(P)} 2 0 1"]
-    node += [f"{i + 1} {_numbers(p)} {m}" for i, (p, m) in
-             enumerate(zip(P.tolist(), on_boundary.tolist()))]
-    ele = ["# written by aftmesh: triangle, three vertices (counter-clockwise), region",
-           f"{len(T)} 3 1"]
-    ele += [f"{i + 1} {a + 1} {b + 1} {c + 1} {r}" for i, ((a, b, c), r) in
-            enumerate(zip(T.tolist(), mesh.regions.tolist()))]
+    node = [
+        "# written by aftmesh: vertex, x, y, boundary marker (1 on the boundary)",
+        f"{len(P)} 2 0 1",
+    ]
+    node += [
+        f"{i + 1} {_numbers(p)} {m}"
+        for i, (p, m) in enumerate(zip(P.tolist(), on_boundary.tolist()))
+    ]
+    ele = [
+        "# written by aftmesh: triangle, three vertices (counter-clockwise), region",
+        f"{len(T)} 3 1",
+    ]
+    ele += [
+        f"{i + 1} {a + 1} {b + 1} {c + 1} {r}"
+        for i, ((a, b, c), r) in enumerate(zip(T.tolist(), mesh.regions.tolist()))
+    ]
     path.with_suffix(".node").write_text("\n".join(node) + "\n", encoding="utf-8")
     path.with_suffix(".ele").write_text("\n".join(ele) + "\n", encoding="utf-8")
 

@@ -1,4 +1,5 @@
 """The result object: a small immutable mesh of plain numpy arrays."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -82,13 +83,19 @@ class Mesh:
         object.__setattr__(self, "tag_names", dict(self.tag_names or {}))
 
     @classmethod
-    def _adopt(cls, **arrays) -> "Mesh":
+    def _adopt(cls, **arrays) -> Mesh:
         """Build a Mesh from arrays the caller hands over (fresh, of the right dtype):
         they are frozen in place instead of copied, which keeps the peak memory of a
         large mesh at one copy of its arrays."""
         mesh = object.__new__(cls)
-        dtypes = dict(points=np.float64, triangles=np.int32, neighbors=np.int32,
-                      segments=np.int32, regions=np.int32, segment_markers=np.int32)
+        dtypes = dict(
+            points=np.float64,
+            triangles=np.int32,
+            neighbors=np.int32,
+            segments=np.int32,
+            regions=np.int32,
+            segment_markers=np.int32,
+        )
         for name, dtype in dtypes.items():
             arr = np.ascontiguousarray(arrays[name], dtype=dtype)
             arr.setflags(write=False)
@@ -125,11 +132,13 @@ class Mesh:
         if isinstance(tag, str):
             if tag not in self.tag_names or self.segment_tags is None:
                 raise InvalidOptionError(
-                    f"no boundary part named {tag!r}: the names are {sorted(self.tag_names)}")
+                    f"no boundary part named {tag!r}: the names are {sorted(self.tag_names)}"
+                )
             return np.flatnonzero(self.segment_tags == self.tag_names[tag])
         if isinstance(tag, (bool, np.bool_)) or not isinstance(tag, (int, np.integer)):
             raise InvalidOptionError(
-                f"tag must be a name from tag_names or an integer marker, got {tag!r}")
+                f"tag must be a name from tag_names or an integer marker, got {tag!r}"
+            )
         return np.flatnonzero(self.segment_markers == tag)
 
     @property
@@ -208,8 +217,10 @@ class Mesh:
         return out
 
     def __repr__(self) -> str:
-        lines = [f"aftmesh.Mesh: {self.n_points} points, {self.n_triangles} triangles, "
-                 f"{len(self.segments)} segments"]
+        lines = [
+            f"aftmesh.Mesh: {self.n_points} points, {self.n_triangles} triangles, "
+            f"{len(self.segments)} segments"
+        ]
         if self.n_triangles:
             lo = self.points.min(axis=0)
             hi = self.points.max(axis=0)
@@ -217,8 +228,10 @@ class Mesh:
             lines.append(f"  bounds: x [{lo[0]:.6g}, {hi[0]:.6g}], y [{lo[1]:.6g}, {hi[1]:.6g}]")
             regions = np.unique(self.regions)
             lines.append(f"  regions: {regions.tolist() if len(regions) <= 8 else len(regions)}")
-            lines.append(f"  angles: min {q['min_angle'].min():.2f} deg, max {q['max_angle'].max():.2f} deg;"
-                         f" radius ratio mean {q['radius_ratio'].mean():.4f}")
+            lines.append(
+                f"  angles: min {q['min_angle'].min():.2f} deg, max {q['max_angle'].max():.2f} deg;"
+                f" radius ratio mean {q['radius_ratio'].mean():.4f}"
+            )
         return "\n".join(lines)
 
     def write(self, path, file_format: str | None = None) -> None:
@@ -230,6 +243,7 @@ class Mesh:
         aftmesh[io]``), with the region of each triangle as cell data ``region``.
         """
         from . import io as _io
+
         _io.write_mesh(self, Path(path), file_format)
 
     def plot(self, ax=None, color_by: str = "quality", show_segments: bool = True, **kwargs):
@@ -248,5 +262,7 @@ class Mesh:
         matplotlib Axes
         """
         from . import plotting
-        return plotting.plot_mesh(self, ax=ax, color_by=color_by,
-                                  show_segments=show_segments, **kwargs)
+
+        return plotting.plot_mesh(
+            self, ax=ax, color_by=color_by, show_segments=show_segments, **kwargs
+        )

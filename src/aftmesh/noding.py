@@ -7,6 +7,7 @@ free end, see :func:`snap_tolerance`), segments given twice dropped, and crossin
 noded.  Each segment carries ``src``, the index of the input edge it is a piece of, so
 every piece can be traced back to what the user drew.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -16,8 +17,13 @@ from shapely.geometry import Point
 from ._kernel import py_orient2d
 from .errors import CrossingSegmentsError
 
-__all__ = ["snap_tolerance", "merge_and_node", "node_crossings", "split_at_vertices",
-           "refuse_crossings"]
+__all__ = [
+    "snap_tolerance",
+    "merge_and_node",
+    "node_crossings",
+    "split_at_vertices",
+    "refuse_crossings",
+]
 
 # Segments still crossing after this many rounds of noding are left for the CDT to
 # report: each round only bends pieces by an ulp, so one or two rounds suffice.
@@ -42,8 +48,9 @@ def snap_tolerance(pts: np.ndarray) -> float:
     return 2.0 * float(np.spacing(np.abs(pts).max()))
 
 
-def merge_and_node(verts, segs, src, note, ring_source, tolerance: float = 0.0,
-                   report: dict | None = None):
+def merge_and_node(
+    verts, segs, src, note, ring_source, tolerance: float = 0.0, report: dict | None = None
+):
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
     the outer ring, a T-junction between regions, a constraint line ending on a
@@ -57,8 +64,7 @@ def merge_and_node(verts, segs, src, note, ring_source, tolerance: float = 0.0,
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
         if n_merged:
-            note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} "
-                        "of another")
+            note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
     uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
     segs = inverse.reshape(-1)[segs]
     tol = max(snap_tolerance(uniq), tolerance)
@@ -88,6 +94,7 @@ def merge_close(verts: np.ndarray, tolerance: float):
             parent[v] = parent[parent[v]]
             v = parent[v]
         return v
+
     for a, b in zip(i[pairs].tolist(), j[pairs].tolist()):
         ra, rb = root(a), root(b)
         if ra != rb:
@@ -172,13 +179,17 @@ def _cut(pts, segs, src, cuts):
         d = pts[b] - pts[a]
         major = 0 if abs(d[0]) >= abs(d[1]) else 1
         sign = np.where(d >= 0, 1.0, -1.0)
-        inner = sorted(set(cuts[k]) - {a, b},
-                       key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]))
+        inner = sorted(
+            set(cuts[k]) - {a, b},
+            key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]),
+        )
         chain = [a, *inner, b]
         out_s.append(np.c_[chain[:-1], chain[1:]])
         out_src.append([src[k]] * (len(chain) - 1))
-    return (np.concatenate(out_s).astype(np.int64),
-            np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64))
+    return (
+        np.concatenate(out_s).astype(np.int64),
+        np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64),
+    )
 
 
 def _drop_repeats(segs, src):
@@ -189,8 +200,9 @@ def _drop_repeats(segs, src):
     return segs[first], src[first]
 
 
-def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None,
-                      counts: dict | None = None):
+def split_at_vertices(
+    pts, segs, src, note, tol: float = 0.0, ring_source=None, counts: dict | None = None
+):
     """Split each segment at the vertices lying on its interior: exactly (decided with
     the exact orientation predicate), or, for a vertex on no polygon ring (a line's end
     or bend, a lone point), within `tol` of it (see snap_tolerance).  ring_source[s]
@@ -202,7 +214,7 @@ def split_at_vertices(pts, segs, src, note, tol: float = 0.0, ring_source=None,
     lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
     reach = max(tol, CANDIDATE_REACH * float(np.abs(pts).max() + 1.0))
     vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
-    other = (vi != segs[si, 0]) & (vi != segs[si, 1])     # each segment finds its own ends
+    other = (vi != segs[si, 0]) & (vi != segs[si, 1])  # each segment finds its own ends
     vi, si = vi[other], si[other]
     cuts: dict[int, list[int]] = {}
     if ring_source is None:
@@ -251,4 +263,6 @@ def refuse_crossings(pts, seg):
         raise CrossingSegmentsError(
             f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
             f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
-            f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})", (i, j))
+            f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})",
+            (i, j),
+        )

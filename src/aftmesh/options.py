@@ -3,6 +3,7 @@
 Every option is validated here, with a message naming it and the value given, before
 any geometry is touched; the stages after this read a frozen :class:`Options`.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -21,7 +22,7 @@ ORDERS = {"shortest": Order.SHORTEST, "longest": Order.LONGEST, "oldest": Order.
 # Smoothing stops by itself once nothing moves; a larger request is surely a mistake.
 MAX_SMOOTH = 1000
 # Kernel indices are int32: refuse a request for more triangles than that can number.
-MAX_TRIANGLES = 2 ** 30
+MAX_TRIANGLES = 2**30
 
 
 @dataclass(frozen=True)
@@ -85,34 +86,63 @@ def _check_max_triangles(max_triangles) -> int | None:
     return min(int(max_triangles), MAX_TRIANGLES)
 
 
-def check_options(*, order, max_triangles, min_area, greedy, swaps, split_boundary,
-                  gradation, close_factor, smooth, strategy, progress, repair=False,
-                  tolerance=0.0, boundary_tags=None) -> Options:
+def check_options(
+    *,
+    order,
+    max_triangles,
+    min_area,
+    greedy,
+    swaps,
+    split_boundary,
+    gradation,
+    close_factor,
+    smooth,
+    strategy,
+    progress,
+    repair=False,
+    tolerance=0.0,
+    boundary_tags=None,
+) -> Options:
     """Validate generate's keyword options; return them as an :class:`Options`."""
-    _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary,
-                      repair=repair))
+    _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary, repair=repair))
     if not isinstance(order, str) or order not in ORDERS:
         raise InvalidOptionError(
-            f"order={order!r} is not a valid option, must be one of {sorted(ORDERS)}")
+            f"order={order!r} is not a valid option, must be one of {sorted(ORDERS)}"
+        )
     max_triangles = _check_max_triangles(max_triangles)
     if min_area is not None and real("min_area", min_area) < 0:
         raise InvalidOptionError(f"min_area must be >= 0, got {min_area!r}")
     if not 0 <= real("close_factor", close_factor) < 2:
         raise InvalidOptionError(f"close_factor must be in [0, 2), got {close_factor!r}")
-    if isinstance(smooth, (bool, np.bool_)) or not isinstance(smooth, (int, np.integer)) \
-            or not 0 <= smooth <= MAX_SMOOTH:
+    if (
+        isinstance(smooth, (bool, np.bool_))
+        or not isinstance(smooth, (int, np.integer))
+        or not 0 <= smooth <= MAX_SMOOTH
+    ):
         raise InvalidOptionError(
-            f"smooth must be a number of rounds from 0 to {MAX_SMOOTH}, got {smooth!r}")
+            f"smooth must be a number of rounds from 0 to {MAX_SMOOTH}, got {smooth!r}"
+        )
     if strategy is not None and not isinstance(strategy, Strategy):
         raise InvalidOptionError(
-            f"strategy must be an aftmesh.aft.Strategy (or a subclass), got {strategy!r}")
+            f"strategy must be an aftmesh.aft.Strategy (or a subclass), got {strategy!r}"
+        )
     gradation = real("gradation", gradation, InvalidSizeError)
     tolerance = real("tolerance", tolerance)
     if tolerance < 0:
         raise InvalidOptionError(f"tolerance must be >= 0, got {tolerance!r}")
-    return Options(order=order, max_triangles=max_triangles, min_area=min_area,
-                   greedy=bool(greedy), swaps=bool(swaps),
-                   split_boundary=bool(split_boundary), gradation=gradation,
-                   close_factor=float(close_factor), smooth=int(smooth), strategy=strategy,
-                   progress=progress, repair=bool(repair), tolerance=tolerance,
-                   boundary_tags=boundary_tags)
+    return Options(
+        order=order,
+        max_triangles=max_triangles,
+        min_area=min_area,
+        greedy=bool(greedy),
+        swaps=bool(swaps),
+        split_boundary=bool(split_boundary),
+        gradation=gradation,
+        close_factor=float(close_factor),
+        smooth=int(smooth),
+        strategy=strategy,
+        progress=progress,
+        repair=bool(repair),
+        tolerance=tolerance,
+        boundary_tags=boundary_tags,
+    )

@@ -10,6 +10,7 @@ failure is raised again as the same exception type with ``domain i:`` in front o
 message (and ``index`` set on it); with ``errors="collect"`` it is returned in its slot
 as a :class:`MeshingFailure` while the other domains still mesh.
 """
+
 from __future__ import annotations
 
 import concurrent.futures as cf
@@ -49,11 +50,13 @@ class MeshingFailure:
     index: int
     error: BaseException
 
-    def __bool__(self) -> bool:          # `if result:` skips failures
+    def __bool__(self) -> bool:  # `if result:` skips failures
         return False
 
     def __repr__(self) -> str:
-        return f"MeshingFailure(index={self.index}, error={type(self.error).__name__}: {self.error})"
+        return (
+            f"MeshingFailure(index={self.index}, error={type(self.error).__name__}: {self.error})"
+        )
 
 
 # ---------------------------------------------------------------- the per-domain task
@@ -61,9 +64,10 @@ def _mesh_one(index: int, domain, size, options: dict):
     """Mesh one domain; a failure comes back as a value, so that it travels from a
     Dask worker like a result and the driver decides whether to raise it."""
     from .generate import generate
+
     try:
         return generate(domain, size, **options)
-    except Exception as err:            # noqa: BLE001  (every failure is reported)
+    except Exception as err:  # noqa: BLE001  (every failure is reported)
         return MeshingFailure(index, err)
 
 
@@ -77,12 +81,12 @@ def _with_index(failure: MeshingFailure) -> BaseException:
     err = failure.error
     try:
         new = copy.copy(err)
-        new.args = (f"domain {failure.index}: {err.args[0] if err.args else err}",
-                    *err.args[1:])
-    except Exception:                   # noqa: BLE001  (an exotic exception type)
+        new.args = (f"domain {failure.index}: {err.args[0] if err.args else err}", *err.args[1:])
+    except Exception:  # noqa: BLE001  (an exotic exception type)
         new = err
-        new.add_note(f"raised by domain {failure.index}")
-    new.index = failure.index
+        if hasattr(new, "add_note"):  # Python >= 3.11
+            new.add_note(f"raised by domain {failure.index}")
+    setattr(new, "index", failure.index)  # noqa: B010  (not a declared attribute)
     return new
 
 
@@ -117,20 +121,24 @@ def _pairs(domains, size) -> Iterator[tuple[int, Any, Any]]:
     if len(sizes) != len(domains):
         raise InvalidOptionError(
             f"size has {len(sizes)} entries for {len(domains)} domains: give one size for "
-            "all or one per domain")
+            "all or one per domain"
+        )
     return ((i, d, s) for i, (d, s) in enumerate(zip(domains, sizes)))
 
 
 def _check(scheduler, errors, workers, chunksize, client):
     if scheduler not in _SCHEDULERS:
         raise InvalidOptionError(
-            f"scheduler={scheduler!r} is not a valid option, must be one of {list(_SCHEDULERS)}")
+            f"scheduler={scheduler!r} is not a valid option, must be one of {list(_SCHEDULERS)}"
+        )
     if errors not in _ERRORS:
         raise InvalidOptionError(
-            f"errors={errors!r} is not a valid option, must be one of {list(_ERRORS)}")
+            f"errors={errors!r} is not a valid option, must be one of {list(_ERRORS)}"
+        )
     for name, value in (("workers", workers), ("chunksize", chunksize)):
-        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, np.integer))
-                                  or value < 1):
+        if value is not None and (
+            isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1
+        ):
             raise InvalidOptionError(f"{name} must be a positive integer, got {value!r}")
     if client is not None and scheduler == "serial":
         raise InvalidOptionError("client= needs scheduler='dask' (or the default)")
@@ -144,13 +152,15 @@ def dask_client(client=None):
         from distributed import get_client
     except ImportError:
         raise InvalidOptionError(
-            "scheduler='dask' needs dask.distributed: pip install aftmesh[dask]") from None
+            "scheduler='dask' needs dask.distributed: pip install aftmesh[dask]"
+        ) from None
     try:
         return get_client()
     except ValueError:
         raise InvalidOptionError(
             "scheduler='dask' found no active dask.distributed Client: start one "
-            "(distributed.Client(...)) or pass client=") from None
+            "(distributed.Client(...)) or pass client="
+        ) from None
 
 
 # ---------------------------------------------------------------- backends
@@ -195,10 +205,13 @@ def _batches(items, chunksize):
 def _dask(items, options, client, chunksize) -> Iterator[tuple[int, Any]]:
     """Batches of domains as Dask tasks, a bounded window of them in flight."""
     from distributed import as_completed
+
     n_workers = max(1, len(client.scheduler_info().get("workers", {})))
     batches = _batches(items, chunksize)
-    pending = {client.submit(_mesh_batch, b, options, pure=False)
-               for b in itertools.islice(batches, n_workers * IN_FLIGHT_PER_WORKER)}
+    pending = {
+        client.submit(_mesh_batch, b, options, pure=False)
+        for b in itertools.islice(batches, n_workers * IN_FLIGHT_PER_WORKER)
+    }
     queue = as_completed(list(pending), loop=client.loop)
     try:
         for fut in queue:
@@ -218,8 +231,7 @@ def _dask(items, options, client, chunksize) -> Iterator[tuple[int, Any]]:
 def _refreeze(result):
     """A Mesh unpickled from a worker has writeable arrays: freeze them again."""
     if isinstance(result, Mesh):
-        for name in ("points", "triangles", "neighbors", "segments", "regions",
-                     "segment_markers"):
+        for name in ("points", "triangles", "neighbors", "segments", "regions", "segment_markers"):
             arr = getattr(result, name)
             if arr is not None and arr.flags.writeable:
                 arr.setflags(write=False)
@@ -227,10 +239,18 @@ def _refreeze(result):
 
 
 # ---------------------------------------------------------------- public API
-def imap_many(domains: Iterable, size=None, *, workers: int | None = None,
-              scheduler: str = "threads", client=None, errors: str = "raise",
-              progress: Callable[[int, int | None], None] | None = None,
-              chunksize: int | None = None, **options) -> Iterator[tuple[int, Mesh | MeshingFailure]]:
+def imap_many(
+    domains: Iterable,
+    size=None,
+    *,
+    workers: int | None = None,
+    scheduler: str = "threads",
+    client=None,
+    errors: str = "raise",
+    progress: Callable[[int, int | None], None] | None = None,
+    chunksize: int | None = None,
+    **options,
+) -> Iterator[tuple[int, Mesh | MeshingFailure]]:
     """Mesh many domains in parallel, yielding ``(index, mesh)`` as each one finishes.
 
     The lazy form of :func:`generate_many` (same parameters): results come in the
@@ -253,8 +273,7 @@ def imap_many(domains: Iterable, size=None, *, workers: int | None = None,
     items = _pairs(domains, size)
     if scheduler == "dask":
         client = dask_client(client)
-    return _results(items, total, scheduler, workers, client, errors, progress, chunksize,
-                    options)
+    return _results(items, total, scheduler, workers, client, errors, progress, chunksize, options)
 
 
 def _results(items, total, scheduler, workers, client, errors, progress, chunksize, options):
@@ -281,10 +300,18 @@ def _length(domains) -> int | None:
         return None
 
 
-def generate_many(domains: Iterable, size=None, *, workers: int | None = None,
-                  scheduler: str = "threads", client=None, errors: str = "raise",
-                  progress: Callable[[int, int | None], None] | None = None,
-                  chunksize: int | None = None, **options) -> list:
+def generate_many(
+    domains: Iterable,
+    size=None,
+    *,
+    workers: int | None = None,
+    scheduler: str = "threads",
+    client=None,
+    errors: str = "raise",
+    progress: Callable[[int, int | None], None] | None = None,
+    chunksize: int | None = None,
+    **options,
+) -> list:
     """Mesh many domains in parallel: ``[aftmesh.generate(d, s, **options), ...]``.
 
     Parameters
@@ -343,7 +370,17 @@ def generate_many(domains: Iterable, size=None, *, workers: int | None = None,
     >>> out[1].index, isinstance(out[1].error, aftmesh.InvalidDomainError)
     (1, True)
     """
-    out: dict[int, Any] = dict(imap_many(domains, size, workers=workers, scheduler=scheduler,
-                                         client=client, errors=errors, progress=progress,
-                                         chunksize=chunksize, **options))
+    out: dict[int, Any] = dict(
+        imap_many(
+            domains,
+            size,
+            workers=workers,
+            scheduler=scheduler,
+            client=client,
+            errors=errors,
+            progress=progress,
+            chunksize=chunksize,
+            **options,
+        )
+    )
     return [out[i] for i in range(len(out))]

@@ -17,11 +17,13 @@ If the cuts cannot be laid without crossing the boundary's pieces (a boundary
 wiggling at the scale of the size right where a cut meets it), the domain is meshed
 serially and ``info['partition_fallback']`` says why.
 """
+
 from __future__ import annotations
 
 import concurrent.futures as cf
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,8 +35,8 @@ from .stitch import lawson_flips, stitch_parts
 
 __all__ = ["generate_partitioned"]
 
-SAMPLES = 256          # sampling grid per side for the expected-triangle integral
-MARGIN = 0.02          # a cut stays this fraction of its box's side away from its ends
+SAMPLES = 256  # sampling grid per side for the expected-triangle integral
+MARGIN = 0.02  # a cut stays this fraction of its box's side away from its ends
 
 
 # ------------------------------------------------------------------------------------
@@ -43,32 +45,46 @@ MARGIN = 0.02          # a cut stays this fraction of its box's side away from i
 # ------------------------------------------------------------------------------------
 @dataclass
 class Boundary:
-    points: np.ndarray      # discretized boundary vertices (and fixed points)
-    segments: np.ndarray    # pieces of the input edges
-    markers: np.ndarray     # Mesh.segment_markers of each piece
-    triangles: np.ndarray   # a triangulation of the domain on those vertices
-    regions: np.ndarray     # its region labels (the serial mesh's numbering)
-    field: object           # the graded size field, callable f(x, y)
+    points: np.ndarray  # discretized boundary vertices (and fixed points)
+    segments: np.ndarray  # pieces of the input edges
+    markers: np.ndarray  # Mesh.segment_markers of each piece
+    triangles: np.ndarray  # a triangulation of the domain on those vertices
+    regions: np.ndarray  # its region labels (the serial mesh's numbering)
+    field: Callable  # the graded size field, callable f(x, y)
 
 
 def discretized_boundary(domain, size, options: dict) -> Boundary:
     """The boundary split by the size exactly as ``generate`` splits it, and the
     graded size field: a greedy run (no interior point) yields both."""
     from .generate import generate
-    keep = {k: options[k] for k in ("split_boundary", "gradation", "repair", "tolerance")
-            if k in options}
+
+    keep = {
+        k: options[k]
+        for k in ("split_boundary", "gradation", "repair", "tolerance")
+        if k in options
+    }
     m = generate(domain, size, greedy=True, smooth=0, **keep)
-    return Boundary(m.points, m.segments, m.segment_markers, m.triangles, m.regions,
-                    m.info["size_field"])
+    return Boundary(
+        m.points,
+        m.segments,
+        np.asarray(m.segment_markers),
+        m.triangles,
+        m.regions,
+        m.info["size_field"],
+    )
 
 
 def split_by_size(p0: np.ndarray, p1: np.ndarray, field) -> np.ndarray:
     """The points strictly between p0 and p1 that split the segment for the size,
     by the rule that splits the input edges."""
     from .boundary import discretize
-    verts, _, _ = discretize(np.array([p0, p1], dtype=np.float64), np.array([[0, 1]]),
-                             np.zeros(1, dtype=np.int32), field)
+
+    verts, _, _ = discretize(
+        np.array([p0, p1], dtype=np.float64), np.array([[0, 1]]), np.zeros(1, dtype=np.int32), field
+    )
     return verts[2:]
+
+
 # ------------------------------------------------------------------------------------
 
 
@@ -140,7 +156,7 @@ def _insert_cut(P: list, S: list, axis: int, c: float, box, field, locate) -> fl
     or so if it ran through a vertex."""
     pts = np.concatenate(P)
     seg = np.concatenate(S)
-    while (pts[:, axis] == c).any():        # the line through no vertex
+    while (pts[:, axis] == c).any():  # the line through no vertex
         c = float(np.nextafter(c, np.inf))
     other = 1 - axis
     a, b = pts[seg[:, 0]], pts[seg[:, 1]]
@@ -190,8 +206,10 @@ def _faces(C: Mesh):
     that are not segments), and whether each half-edge (t, k) is a segment."""
     T, N = C.triangles, C.neighbors
     n = max(len(C.points), 1)
-    seg_key = np.sort(np.minimum(C.segments[:, 0], C.segments[:, 1]).astype(np.int64) * n
-                      + np.maximum(C.segments[:, 0], C.segments[:, 1]))
+    seg_key = np.sort(
+        np.minimum(C.segments[:, 0], C.segments[:, 1]).astype(np.int64) * n
+        + np.maximum(C.segments[:, 0], C.segments[:, 1])
+    )
     a, b = T[:, [1, 2, 0]].astype(np.int64), T[:, [2, 0, 1]].astype(np.int64)
     key = np.minimum(a, b) * n + np.maximum(a, b)
     pos = np.minimum(np.searchsorted(seg_key, key), len(seg_key) - 1)
@@ -218,18 +236,24 @@ def _face_owners(C: Mesh, face, n_faces, leaves, locate):
     of its area), whether it is inside the domain and its region label."""
     p = C.points[C.triangles]
     centroid = p.mean(axis=1)
-    area = 0.5 * np.abs((p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
-                        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0]))
+    area = 0.5 * np.abs(
+        (p[:, 1, 0] - p[:, 0, 0]) * (p[:, 2, 1] - p[:, 0, 1])
+        - (p[:, 1, 1] - p[:, 0, 1]) * (p[:, 2, 0] - p[:, 0, 0])
+    )
     box = np.zeros(len(centroid), dtype=np.int64)
     for i, (x0, y0, x1, y1) in enumerate(leaves):
-        box[(centroid[:, 0] >= x0) & (centroid[:, 1] >= y0)
-            & (centroid[:, 0] <= x1) & (centroid[:, 1] <= y1)] = i
+        box[
+            (centroid[:, 0] >= x0)
+            & (centroid[:, 1] >= y0)
+            & (centroid[:, 0] <= x1)
+            & (centroid[:, 1] <= y1)
+        ] = i
     votes = np.zeros((n_faces, len(leaves)))
     np.add.at(votes, (face, box), area)
     owner = votes.argmax(axis=1)
     best = np.full(n_faces, -1)
     order = np.argsort(area, kind="stable")
-    best[face[order]] = order                      # the largest triangle wins
+    best[face[order]] = order  # the largest triangle wins
     probes = centroid[best]
     inside, label = locate(probes)
     return probes, owner, inside, label
@@ -264,19 +288,22 @@ def part_inputs(C: Mesh, leaves, locate) -> tuple[list[dict], list[np.ndarray]]:
             hit = np.unique(tree.query(shapely.points(others), predicate="intersects")[0])
             others = others[hit]
         regions = np.c_[probes[mine], label[mine]]
-        out.append({"vertices": pts, "segments": local, "holes": others.reshape(-1, 2),
-                    "regions": regions})
+        out.append(
+            {"vertices": pts, "segments": local, "holes": others.reshape(-1, 2), "regions": regions}
+        )
         ids.append(used)
     return out, ids
 
 
 def _coarse_cdt(points, segments) -> Mesh:
     from .cdt import cdt
+
     return cdt(points, segments)
 
 
 def _mesh_part(part: dict, field, options: dict) -> Mesh:
     from .generate import generate
+
     return generate(part, field, split_boundary=False, **options)
 
 
@@ -292,8 +319,11 @@ def _run_parts(parts, field, options, client, workers):
 
 
 def _check(partitions, options) -> int:
-    if isinstance(partitions, bool) or not isinstance(partitions, (int, np.integer)) \
-            or partitions < 1:
+    if (
+        isinstance(partitions, bool)
+        or not isinstance(partitions, (int, np.integer))
+        or partitions < 1
+    ):
         raise InvalidOptionError(f"partitions must be a positive integer, got {partitions!r}")
     if partitions > 1:
         for name in ("max_triangles", "strategy", "boundary_tags"):
@@ -301,7 +331,8 @@ def _check(partitions, options) -> int:
                 raise InvalidOptionError(f"{name} cannot be combined with partitions > 1")
         if options.get("greedy"):
             raise InvalidOptionError(
-                "greedy=True adds no point, but partitions > 1 adds the cut vertices")
+                "greedy=True adds no point, but partitions > 1 adds the cut vertices"
+            )
     return int(partitions)
 
 
@@ -309,20 +340,30 @@ def _cut_pslg(b: Boundary, k: int):
     """Boundary + cuts as (points, segments, leaves, locator), or a reason why not."""
     locate = _Locator(b)
     P, S = [b.points], [b.segments.astype(np.int64)]
-    leaves = plan_cuts(b, locate, k, lambda axis, c, box: _insert_cut(
-        P, S, axis, c, box, b.field, locate))
+    leaves = plan_cuts(
+        b, locate, k, lambda axis, c, box: _insert_cut(P, S, axis, c, box, b.field, locate)
+    )
     pts = np.concatenate(P)
     seg = np.unique(np.sort(np.concatenate(S), axis=1), axis=0)
     return pts, seg, leaves, locate
 
 
-def generate_partitioned(domain, size=None, *, partitions: int, client=None,
-                         workers: int | None = None, out=None, options: dict | None = None):
+def generate_partitioned(
+    domain,
+    size=None,
+    *,
+    partitions: int,
+    client=None,
+    workers: int | None = None,
+    out=None,
+    options: dict | None = None,
+):
     """``aftmesh.generate(domain, size, partitions=k, client=..., out=...)``: see the
     module documentation.  ``options`` are generate's other keyword options.  With
     ``out`` (a directory) the parts are written there by the workers that mesh them
     (see :mod:`aftmesh.partition_io`) and the path of the ``.pvtu`` is returned."""
     from .generate import generate
+
     options = {k: v for k, v in (options or {}).items() if v is not None}
     k = _check(partitions, options)
     if k == 1 and client is None and out is None:
@@ -332,8 +373,11 @@ def generate_partitioned(domain, size=None, *, partitions: int, client=None,
     pts, seg, leaves, locate = _cut_pslg(b, k)
     try:
         C = _coarse_cdt(pts, seg)
-        reason = None if len(C.segments) == len(seg) and len(C.points) == len(pts) else \
-            "a cut runs through a vertex of the boundary"
+        reason = (
+            None
+            if len(C.segments) == len(seg) and len(C.points) == len(pts)
+            else "a cut runs through a vertex of the boundary"
+        )
     except CrossingSegmentsError:
         reason = "a cut crosses the boundary's pieces"
     if reason is not None and out is None:
@@ -344,24 +388,43 @@ def generate_partitioned(domain, size=None, *, partitions: int, client=None,
         raise InvalidOptionError(f"out= cannot write this domain in parts: {reason}")
     parts, ids = part_inputs(C, leaves, locate)
     t1 = time.perf_counter()
-    part_options = {key: v for key, v in options.items()
-                    if key not in ("split_boundary", "progress", "greedy", "repair",
-                                   "tolerance")}
+    part_options = {
+        key: v
+        for key, v in options.items()
+        if key not in ("split_boundary", "progress", "greedy", "repair", "tolerance")
+    }
     if out is not None:
         from .partition_io import part_meta, write_parts
+
         metas = part_meta(C, ids, b.points[b.segments], b.markers)
-        return write_parts(out, parts, metas, b.field, part_options, _mesh_part, client,
-                           workers)
+        return write_parts(out, parts, metas, b.field, part_options, _mesh_part, client, workers)
     meshes = _run_parts(parts, b.field, part_options, client, workers)
     t2 = time.perf_counter()
     xy = b.points[b.segments]
     P, T, N, R, segments, markers, cut, cut_vertices, constrained = stitch_parts(
-        meshes, xy, b.markers)
+        meshes, xy, b.markers
+    )
     flips = lawson_flips(P, T, N, constrained, cut)
-    info = {"partitions": len(meshes), "part_triangles": [m.n_triangles for m in meshes],
-            "cut_edges": len(cut), "cut_vertices": cut_vertices, "cut_flips": flips, "size_field": b.field,
-            "timing": {"plan": t1 - t0, "parts": t2 - t1,
-                       "stitch": time.perf_counter() - t2,
-                       "total": time.perf_counter() - t0}}
-    return Mesh._adopt(points=P, triangles=T, neighbors=N, segments=segments, regions=R,
-                       segment_markers=markers, info=info)
+    info = {
+        "partitions": len(meshes),
+        "part_triangles": [m.n_triangles for m in meshes],
+        "cut_edges": len(cut),
+        "cut_vertices": cut_vertices,
+        "cut_flips": flips,
+        "size_field": b.field,
+        "timing": {
+            "plan": t1 - t0,
+            "parts": t2 - t1,
+            "stitch": time.perf_counter() - t2,
+            "total": time.perf_counter() - t0,
+        },
+    }
+    return Mesh._adopt(
+        points=P,
+        triangles=T,
+        neighbors=N,
+        segments=segments,
+        regions=R,
+        segment_markers=markers,
+        info=info,
+    )

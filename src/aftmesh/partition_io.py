@@ -12,6 +12,7 @@ of a cut in one place, so it is not run: each part is the CDT of its own vertice
 segments, and ``info['cut_flips']`` of an in-memory run of the same domain says whether
 a flip would have been needed (none in the test domains).
 """
+
 from __future__ import annotations
 
 import concurrent.futures as cf
@@ -54,8 +55,15 @@ def _write(mesh, part: dict, meta: dict, offset: int, path: str) -> tuple:
     pieces, markers = meta["pieces"], meta["markers"]
     pos = np.minimum(np.searchsorted(pieces, key), max(len(pieces) - 1, 0))
     keep = pieces[pos] == key if len(pieces) else np.zeros(len(key), dtype=bool)
-    write_part(path, mesh.points, gid, mesh.triangles, mesh.regions, mesh.segments[keep],
-               markers[pos[keep]])
+    write_part(
+        path,
+        mesh.points,
+        gid,
+        mesh.triangles,
+        mesh.regions,
+        mesh.segments[keep],
+        markers[pos[keep]],
+    )
     return mesh.n_points, mesh.n_triangles
 
 
@@ -66,14 +74,22 @@ def part_meta(C, used: list, input_xy: np.ndarray, input_markers: np.ndarray) ->
     keys = _void(C.points)
     order = np.argsort(keys)
     ends = order[np.searchsorted(keys[order], _void(input_xy.reshape(-1, 2)))].reshape(-1, 2)
-    key = np.minimum(ends[:, 0], ends[:, 1]).astype(np.int64) * n + np.maximum(ends[:, 0],
-                                                                               ends[:, 1])
+    key = np.minimum(ends[:, 0], ends[:, 1]).astype(np.int64) * n + np.maximum(
+        ends[:, 0], ends[:, 1]
+    )
     srt = np.argsort(key)
     on_seg = np.zeros(n, dtype=bool)
     on_seg[C.segments.ravel()] = True
-    return [{"ids": u.astype(np.int64), "n": n, "pieces": key[srt],
-             "markers": np.asarray(input_markers)[srt], "lone": int((~on_seg[u]).sum())}
-            for u in used]
+    return [
+        {
+            "ids": u.astype(np.int64),
+            "n": n,
+            "pieces": key[srt],
+            "markers": np.asarray(input_markers)[srt],
+            "lone": int((~on_seg[u]).sum()),
+        }
+        for u in used
+    ]
 
 
 def write_parts(out, parts, metas, field, options, mesh_part, client, workers) -> Path:
@@ -84,7 +100,7 @@ def write_parts(out, parts, metas, field, options, mesh_part, client, workers) -
     paths = [str(out / name) for name in names]
     n = metas[0]["n"] if metas else 0
     if client is not None:
-        field = client.scatter(field, broadcast=True)      # once per worker
+        field = client.scatter(field, broadcast=True)  # once per worker
         meshes = client.map(mesh_part, parts, field=field, options=options, pure=False)
         counts = client.gather(client.map(_count_new, meshes, parts, pure=False))
         offsets = (n + np.r_[0, np.cumsum(counts)[:-1]]).tolist()

@@ -2,6 +2,7 @@
 
 matplotlib is imported inside the functions, so ``import aftmesh`` never needs it.
 """
+
 from __future__ import annotations
 
 from os import PathLike
@@ -21,13 +22,25 @@ def _import_matplotlib(what: str):
         import matplotlib  # noqa: F401
     except ImportError:
         raise ModuleNotFoundError(
-            f"{what} needs matplotlib: pip install aftmesh[plot]", name="matplotlib") from None
+            f"{what} needs matplotlib: pip install aftmesh[plot]", name="matplotlib"
+        ) from None
 
 
-def plot_mesh(mesh, ax=None, color_by: str = "quality", show_segments: bool = True, *,
-              cmap=None, edge_color="0.2", edge_width: float | None = None,
-              segment_color="k", segment_width: float = 1.5, colorbar: bool = True,
-              title: str | bool = True, **kwargs):
+def plot_mesh(
+    mesh,
+    ax=None,
+    color_by: str = "quality",
+    show_segments: bool = True,
+    *,
+    cmap=None,
+    edge_color="0.2",
+    edge_width: float | None = None,
+    segment_color="k",
+    segment_width: float = 1.5,
+    colorbar: bool = True,
+    title: str | bool = True,
+    **kwargs,
+):
     """Draw a mesh: filled triangles, thin edges, the segments thicker.
 
     Parameters
@@ -71,12 +84,15 @@ def plot_mesh(mesh, ax=None, color_by: str = "quality", show_segments: bool = Tr
     """
     if color_by not in _COLOR_BY:
         raise InvalidOptionError(
-            f"color_by={color_by!r} is not a valid option, must be one of {list(_COLOR_BY)}")
+            f"color_by={color_by!r} is not a valid option, must be one of {list(_COLOR_BY)}"
+        )
     _import_matplotlib("plotting a mesh")
     from matplotlib.collections import LineCollection
     from matplotlib.colors import BoundaryNorm, Normalize
+
     if ax is None:
         import matplotlib.pyplot as plt
+
         _, ax = plt.subplots()
     P, T = mesh.points, mesh.triangles
     fig = ax.figure
@@ -85,36 +101,61 @@ def plot_mesh(mesh, ax=None, color_by: str = "quality", show_segments: bool = Tr
         edge_width = float(np.clip(12.0 / np.sqrt(max(len(T), 1)), 0.05, 0.6))
     q = triangle_quality(P, T) if len(T) else None
     if len(T):
-        edge_style = dict(edgecolors=edge_color if edge_width > 0 else "none",
-                          linewidth=edge_width)
+        edge_style = dict(edgecolors=edge_color if edge_width > 0 else "none", linewidth=edge_width)
         if color_by == "quality":
             assert q is not None
-            art = ax.tripcolor(P[:, 0], P[:, 1], T, facecolors=q["radius_ratio"],
-                               cmap=cmap or "viridis", norm=Normalize(0.0, 1.0),
-                               **edge_style, **kwargs)
+            art = ax.tripcolor(
+                P[:, 0],
+                P[:, 1],
+                T,
+                facecolors=q["radius_ratio"],
+                cmap=cmap or "viridis",
+                norm=Normalize(0.0, 1.0),
+                **edge_style,
+                **kwargs,
+            )
             if colorbar:
                 fig.colorbar(art, ax=ax, shrink=0.8, label="radius ratio (1 = equilateral)")
         elif color_by == "region":
             values, index = np.unique(mesh.regions, return_inverse=True)
             k = len(values)
             # light qualitative colors keep the edges visible on top of them
-            cmap = cmap or ("Pastel1" if k <= 9 else "Set3" if k <= 12
-                            else "tab20" if k <= 20 else "turbo")
+            cmap = cmap or (
+                "Pastel1" if k <= 9 else "Set3" if k <= 12 else "tab20" if k <= 20 else "turbo"
+            )
             # one color per region, whatever the region numbers are (qualitative maps
             # take the first k colors, longer maps are spread over the k regions)
             ncolors = k if k <= 20 else 256
-            art = ax.tripcolor(P[:, 0], P[:, 1], T, facecolors=index.astype(float),
-                               cmap=cmap, norm=BoundaryNorm(np.arange(k + 1) - 0.5, ncolors),
-                               **edge_style, **kwargs)
+            art = ax.tripcolor(
+                P[:, 0],
+                P[:, 1],
+                T,
+                facecolors=index.astype(float),
+                cmap=cmap,
+                norm=BoundaryNorm(np.arange(k + 1) - 0.5, ncolors),
+                **edge_style,
+                **kwargs,
+            )
             if colorbar:
                 bar = fig.colorbar(art, ax=ax, shrink=0.8, label="region", ticks=np.arange(k))
                 bar.ax.set_yticklabels([str(v) for v in values])
         else:
-            ax.tripcolor(P[:, 0], P[:, 1], T, facecolors=np.zeros(len(T)),
-                         cmap="Greys", norm=Normalize(0.0, 1.0), **edge_style, **kwargs)
+            ax.tripcolor(
+                P[:, 0],
+                P[:, 1],
+                T,
+                facecolors=np.zeros(len(T)),
+                cmap="Greys",
+                norm=Normalize(0.0, 1.0),
+                **edge_style,
+                **kwargs,
+            )
     if show_segments and len(mesh.segments):
-        ax.add_collection(LineCollection(P[mesh.segments], colors=segment_color,
-                                         linewidths=segment_width, zorder=3))
+        ax.add_collection(
+            LineCollection(
+                P[mesh.segments], colors=segment_color, linewidths=segment_width, zorder=3
+            )
+        )
     ax.set_aspect("equal")
     if len(P):
         lo, hi = P.min(axis=0), P.max(axis=0)
@@ -131,8 +172,9 @@ def plot_mesh(mesh, ax=None, color_by: str = "quality", show_segments: bool = Tr
     return ax
 
 
-def save_png(mesh, path: str | PathLike, *, dpi: int = 150, figsize=None, zoom=None,
-             **kwargs) -> None:
+def save_png(
+    mesh, path: str | PathLike, *, dpi: int = 150, figsize=None, zoom=None, **kwargs
+) -> None:
     """Draw a mesh with :func:`plot_mesh` into a PNG file.
 
     Uses a standalone matplotlib ``Figure`` (no pyplot, no window, no global state),
@@ -161,6 +203,7 @@ def save_png(mesh, path: str | PathLike, *, dpi: int = 150, figsize=None, zoom=N
     """
     _import_matplotlib("saving a PNG")
     from matplotlib.figure import Figure
+
     if zoom is not None:
         bad_zoom = InvalidOptionError(f"zoom must be (xmin, xmax, ymin, ymax), got {zoom!r}")
         try:
@@ -169,8 +212,11 @@ def save_png(mesh, path: str | PathLike, *, dpi: int = 150, figsize=None, zoom=N
             raise bad_zoom from None
         if not (x0 < x1 and y0 < y1):
             raise bad_zoom
-    panels = [(mesh.points.min(axis=0), mesh.points.max(axis=0))] if len(mesh.points) \
+    panels = (
+        [(mesh.points.min(axis=0), mesh.points.max(axis=0))]
+        if len(mesh.points)
         else [(np.zeros(2), np.ones(2))]
+    )
     if zoom is not None:
         panels.append((np.array([x0, y0]), np.array([x1, y1])))
     if figsize is None:

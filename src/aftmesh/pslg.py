@@ -12,6 +12,7 @@ Policies (stated once, here):
   crossing a segment is removed (so only regions enclosed by segments remain), then
   every region reachable from a hole point.  Without segments the convex hull is kept.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -32,11 +33,11 @@ MIN_COORDINATE, MAX_COORDINATE = _kernel.EXACT_COORDINATE_RANGE
 @dataclass
 class BuiltCDT:
     kernel: _kernel.Triangulation
-    vertices: np.ndarray        # (n, 2) the validated input vertices
-    segments: np.ndarray        # (m, 2) segments in input vertex numbering
-    merged: np.ndarray          # (n,) input vertex -> kernel vertex it was merged into
+    vertices: np.ndarray  # (n, 2) the validated input vertices
+    segments: np.ndarray  # (m, 2) segments in input vertex numbering
+    merged: np.ndarray  # (n,) input vertex -> kernel vertex it was merged into
     n_merged: int
-    n_split: int = 0            # segments that ran exactly through another vertex
+    n_split: int = 0  # segments that ran exactly through another vertex
 
 
 def as_points(value, name: str) -> np.ndarray:
@@ -65,14 +66,16 @@ def check_range(arr: np.ndarray, name: str) -> None:
         i = int(np.flatnonzero(big)[0])
         raise InvalidInputError(
             f"{name}[{i}] = {arr[i].tolist()} is too large (|coordinate| > {MAX_COORDINATE:g}, "
-            "beyond the range where the exact predicates are exact): rescale the domain")
+            "beyond the range where the exact predicates are exact): rescale the domain"
+        )
     tiny = ((mag < MIN_COORDINATE) & (mag > 0)).any(axis=1)
     if tiny.any():
         i = int(np.flatnonzero(tiny)[0])
         raise InvalidInputError(
             f"{name}[{i}] = {arr[i].tolist()} has a coordinate below {MIN_COORDINATE:g} in "
             "magnitude (but not 0), beneath the range where the exact predicates are exact: "
-            "rescale the domain")
+            "rescale the domain"
+        )
 
 
 def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
@@ -96,18 +99,27 @@ def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
     if bad.any():
         i = int(np.flatnonzero(bad.any(axis=1))[0])
         raise InvalidInputError(
-            f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{n_vertices - 1}")
+            f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{n_vertices - 1}"
+        )
     zero = (seg[:, 0] == seg[:, 1]) | (vertices[seg[:, 0]] == vertices[seg[:, 1]]).all(axis=1)
     if zero.any():
         i = int(np.flatnonzero(zero)[0])
         raise InvalidInputError(
             f"segments[{i}] = {seg[i].tolist()} has zero length "
-            f"(both ends at {vertices[seg[i, 0]].tolist()})")
+            f"(both ends at {vertices[seg[i, 0]].tolist()})"
+        )
     return seg.astype(np.int32)
 
 
-def build_cdt(vertices, segments=None, holes=None, regions=None, *,
-              carve: bool | None = None, nt_hint: int = 0) -> BuiltCDT:
+def build_cdt(
+    vertices,
+    segments=None,
+    holes=None,
+    regions=None,
+    *,
+    carve: bool | None = None,
+    nt_hint: int = 0,
+) -> BuiltCDT:
     """Validate a PSLG and return the kernel triangulation of its domain.
 
     ``regions`` is a sequence of (x, y, marker) rows; ``holes`` an (h, 2) array.
@@ -135,18 +147,21 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
         if frac.any():
             i = int(np.flatnonzero(frac)[0])
             raise InvalidInputError(
-                f"regions[{i}] has marker {float(reg[i, 2])!r}: region markers must be integers")
+                f"regions[{i}] has marker {float(reg[i, 2])!r}: region markers must be integers"
+            )
         big = np.abs(reg[:, 2]) > 2**31 - 1
         if big.any():
             i = int(np.flatnonzero(big)[0])
             raise InvalidInputError(
-                f"regions[{i}] has marker {float(reg[i, 2])!r}, out of the int32 range")
+                f"regions[{i}] has marker {float(reg[i, 2])!r}, out of the int32 range"
+            )
     kernel = _kernel.Triangulation(pts, nt_hint)
     try:
         merged = kernel.insert_points(brio_order(pts))
     except _kernel.CollinearError:
         raise InvalidDomainError(
-            f"all {n} vertices are collinear: there is no triangle to make") from None
+            f"all {n} vertices are collinear: there is no triangle to make"
+        ) from None
     n_merged = int((merged != np.arange(n)).sum())
     kseg = merged[seg] if len(seg) else seg
     try:
@@ -157,11 +172,14 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
         a, b = seg[i]
         if j >= 0:
             c, d = seg[j]
-            msg = (f"segments[{i}] = [{a}, {b}] ({pts[a].tolist()} -> {pts[b].tolist()}) "
-                   f"crosses segments[{j}] = [{c}, {d}] ({pts[c].tolist()} -> {pts[d].tolist()})")
+            msg = (
+                f"segments[{i}] = [{a}, {b}] ({pts[a].tolist()} -> {pts[b].tolist()}) "
+                f"crosses segments[{j}] = [{c}, {d}] ({pts[c].tolist()} -> {pts[d].tolist()})"
+            )
             raise CrossingSegmentsError(msg, (i, j)) from None
         raise CrossingSegmentsError(
-            f"segments[{i}] = [{a}, {b}] crosses another segment", (i,)) from None
+            f"segments[{i}] = [{a}, {b}] crosses another segment", (i,)
+        ) from None
     if carve is None:
         carve = len(seg) > 0
     kernel.carve(np.zeros((0, 2)), carve)
@@ -171,12 +189,15 @@ def build_cdt(vertices, segments=None, holes=None, regions=None, *,
             if state is None:
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) lies on a segment, so it picks no "
-                    "single region: put it strictly inside")
+                    "single region: put it strictly inside"
+                )
             if state != TriangleState.UNMESHED:
                 raise InvalidDomainError(
-                    f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain")
+                    f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain"
+                )
     kernel.carve(hole_pts, False)
     if len(reg):
-        kernel.assign_regions(np.ascontiguousarray(reg[:, :2]),
-                              np.ascontiguousarray(reg[:, 2].astype(np.int32)))
+        kernel.assign_regions(
+            np.ascontiguousarray(reg[:, :2]), np.ascontiguousarray(reg[:, 2].astype(np.int32))
+        )
     return BuiltCDT(kernel, pts, seg, merged, n_merged, n_split)

@@ -1,6 +1,7 @@
 """Shape measures of triangles, shared by :class:`~aftmesh.mesh.Mesh` and the
 pictures (:mod:`aftmesh.plotting`), which import it from here rather than from each
 other."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -24,9 +25,19 @@ def triangle_quality(points: np.ndarray, triangles: np.ndarray) -> dict[str, np.
     with np.errstate(divide="ignore", invalid="ignore"):
         # 2 r_in / r_circ = 16 area^2 / (perimeter a b c)
         rr = np.where(area > 0, 16.0 * area * area / (perimeter * a * b * c), 0.0)
-        cos = np.stack([(b * b + c * c - a * a) / (2 * b * c),
-                        (c * c + a * a - b * b) / (2 * c * a),
-                        (a * a + b * b - c * c) / (2 * a * b)], axis=1)
+        cos = np.stack(
+            [
+                (b * b + c * c - a * a) / (2 * b * c),
+                (c * c + a * a - b * b) / (2 * c * a),
+                (a * a + b * b - c * c) / (2 * a * b),
+            ],
+            axis=1,
+        )
     ang = np.degrees(np.arccos(np.clip(np.nan_to_num(cos, nan=1.0), -1.0, 1.0)))
-    return dict(radius_ratio=rr, min_angle=ang.min(axis=1), max_angle=ang.max(axis=1),
-                area=area, edge_lengths=lengths)
+    return dict(
+        radius_ratio=rr,
+        min_angle=ang.min(axis=1),
+        max_angle=ang.max(axis=1),
+        area=area,
+        edge_lengths=lengths,
+    )

@@ -4,6 +4,7 @@ The segments cut the triangulated domain into pieces (connected sets of triangle
 each piece lies in exactly one of the user's polygons or in none (then it is not
 meshed).  A piece is classified by one point strictly inside one of its triangles.
 """
+
 from __future__ import annotations
 
 from fractions import Fraction
@@ -30,10 +31,13 @@ def classify_pieces(polygons, probes: np.ndarray, corners: np.ndarray) -> np.nda
         (ax, ay), (bx, by), (cx, cy) = corners[c]
         x, y = probes[c]
         side = py_orient2d(ax, ay, bx, by, cx, cy)
-        if side != 0 and py_orient2d(ax, ay, bx, by, x, y) == side \
-                and py_orient2d(bx, by, cx, cy, x, y) == side \
-                and py_orient2d(cx, cy, ax, ay, x, y) == side:
-            continue            # the probe is strictly inside its triangle
+        if (
+            side != 0
+            and py_orient2d(ax, ay, bx, by, x, y) == side
+            and py_orient2d(bx, by, cx, cy, x, y) == side
+            and py_orient2d(cx, cy, ax, ay, x, y) == side
+        ):
+            continue  # the probe is strictly inside its triangle
         region_of[c] = -1
         for k, poly in enumerate(polygons):
             if _exact_inside(poly, corners[c]):
@@ -58,8 +62,9 @@ def _exact_inside(poly, corners: np.ndarray) -> bool:
             c = np.asarray(ring.coords)[:, :2]
             for (xa, ya), (xb, yb) in zip(c[:-1].tolist(), c[1:].tolist()):
                 if (ya > py) != (yb > py):
-                    x = Fraction(xa) + (py - Fraction(ya)) * (Fraction(xb) - Fraction(xa)) \
-                        / (Fraction(yb) - Fraction(ya))
+                    x = Fraction(xa) + (py - Fraction(ya)) * (Fraction(xb) - Fraction(xa)) / (
+                        Fraction(yb) - Fraction(ya)
+                    )
                     if px < x:
                         inside = not inside
     return inside

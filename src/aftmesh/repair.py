@@ -6,6 +6,7 @@ the input folded onto itself (slivers).  Here the polygonal part is kept, the sl
 are dropped, and the user's own constraint lines and points are kept when they lie in
 or on the repaired domain.  Everything dropped is reported.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -54,21 +55,26 @@ def _repair_collection(domain, report: dict):
     others: list = []
     for part in parts:
         (polygons if isinstance(part, (Polygon, MultiPolygon)) else others).append(part)
-    named = [(p, f"polygon {k}" if len(polygons) > 1 else "the polygon")
-             for k, p in enumerate(polygons)]
+    named = [
+        (p, f"polygon {k}" if len(polygons) > 1 else "the polygon") for k, p in enumerate(polygons)
+    ]
     polygons = [_polygonal(p, name, report) for p, name in named]
     if not polygons:
-        return domain          # nothing to repair; the adapter says what is missing
+        return domain  # nothing to repair; the adapter says what is missing
     union = shapely.union_all(polygons)
     kept = []
     for g in others:
         if union.covers(g):
             kept.append(g)
         else:
-            report["dropped"].append(f"a constraint {g.geom_type} at {_where(g)}: "
-                                     "not in or on the repaired domain")
-    return GeometryCollection([*polygons, *kept]) if kept else (
-        polygons[0] if len(polygons) == 1 else GeometryCollection(polygons))
+            report["dropped"].append(
+                f"a constraint {g.geom_type} at {_where(g)}: not in or on the repaired domain"
+            )
+    return (
+        GeometryCollection([*polygons, *kept])
+        if kept
+        else (polygons[0] if len(polygons) == 1 else GeometryCollection(polygons))
+    )
 
 
 def repair_domain(domain, is_ring: bool):

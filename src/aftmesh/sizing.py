@@ -9,6 +9,7 @@ interpolates bilinearly, after a gradation limit has been applied so that the si
 never grows faster than ``gradation`` per unit of length relative to itself
 (h(x) <= h(y) + (gradation - 1) |x - y|).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -76,8 +77,9 @@ class SizeField:
         i1 = np.minimum(i + 1, nx - 1)
         j1 = np.minimum(j + 1, ny - 1)
         h = self.h
-        return ((1 - ty) * ((1 - tx) * h[j, i] + tx * h[j, i1])
-                + ty * ((1 - tx) * h[j1, i] + tx * h[j1, i1]))
+        return (1 - ty) * ((1 - tx) * h[j, i] + tx * h[j, i1]) + ty * (
+            (1 - tx) * h[j1, i] + tx * h[j1, i1]
+        )
 
 
 def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> None:
@@ -86,7 +88,8 @@ def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> Non
         k = np.flatnonzero(bad.ravel())[0]
         raise InvalidSizeError(
             f"{what} gave {h.ravel()[k]!r} at ({X.ravel()[k]:.6g}, {Y.ravel()[k]:.6g}): "
-            "sizes must be finite and positive")
+            "sizes must be finite and positive"
+        )
 
 
 def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
@@ -100,7 +103,8 @@ def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
             f"{what} {h.ravel()[k]:.6g}{where} is below what the coordinates can resolve: "
             f"near {magnitude:.6g}, doubles are {spacing:.3g} apart, and a size must span at "
             f"least {MIN_SIZE_ULPS} of those ({MIN_SIZE_ULPS * spacing:.3g}); use a larger "
-            "size or move the domain nearer the origin")
+            "size or move the domain nearer the origin"
+        )
 
 
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
@@ -126,7 +130,8 @@ def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
         raise InvalidSizeError(
             f"the size callable returned an array of shape {values.shape}: it is called "
             f"with 1-D arrays x, y of length {len(x)} and must return an array of that "
-            "length (one size per point) or a single number")
+            "length (one size per point) or a single number"
+        )
     _check_values(h, X, Y, "the size callable")
     return h
 
@@ -150,10 +155,11 @@ def per_region_size(polygons, sizes):
         values.append(v)
     if len(values) != len(polygons):
         raise InvalidSizeError(
-            f"got {len(values)} sizes for {len(polygons)} regions: give one size per region")
+            f"got {len(values)} sizes for {len(polygons)} regions: give one size per region"
+        )
     prepared = list(polygons)
     for p in prepared:
-        shapely.prepare(p)   # speeds up the repeated point-in-polygon tests
+        shapely.prepare(p)  # speeds up the repeated point-in-polygon tests
 
     def size(x, y):
         x = np.asarray(x, dtype=np.float64)
@@ -163,6 +169,7 @@ def per_region_size(polygons, sizes):
             inside = shapely.intersects_xy(poly, x, y)
             out[inside] = np.minimum(out[inside], v)
         return out
+
     return size
 
 
@@ -192,8 +199,9 @@ def _grid(bounds, spacing: float):
     return xmin, ymin, dx, dy, X, Y
 
 
-def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
-                    gradation: float = DEFAULT_GRADATION) -> SizeField:
+def make_size_field(
+    size, bounds, boundary_points=None, boundary_lengths=None, gradation: float = DEFAULT_GRADATION
+) -> SizeField:
     """Turn a size specification into a :class:`SizeField` over ``bounds``.
 
     The field is the smaller of the user's size and the sizes the boundary itself asks
@@ -218,20 +226,21 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
     constant = None
     if isinstance(size, (bool, np.bool_, str, bytes)):
         # float() would take True as 1 and "0.1" as 0.1: almost surely a mistake
-        raise InvalidSizeError(
-            f"size must be a number, a callable f(x, y) or None, got {size!r}")
+        raise InvalidSizeError(f"size must be a number, a callable f(x, y) or None, got {size!r}")
     if size is not None and not callable(size):
         try:
             constant = float(size)
         except (TypeError, ValueError):
             raise InvalidSizeError(
-                f"size must be a number, a callable f(x, y) or None, got {size!r}") from None
+                f"size must be a number, a callable f(x, y) or None, got {size!r}"
+            ) from None
         if not (np.isfinite(constant) and constant > 0):
             raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
         _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
-    if constant is not None and (not have_boundary
-                                 or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant):
+    if constant is not None and (
+        not have_boundary or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant
+    ):
         # the boundary asks for nothing smaller: a constant needs no grid
         return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[constant]]))
     if size is None and not have_boundary:
@@ -277,8 +286,11 @@ def make_size_field(size, bounds, boundary_points=None, boundary_lengths=None,
         for di in (0, 1):
             for dj in (0, 1):
                 dist = np.hypot(X[j + dj, i + di] - pts[:, 0], Y[j + dj, i + di] - pts[:, 1])
-                np.minimum.at(h, (j + dj, i + di),
-                              lengths + rate * np.maximum(0.0, dist - BOUNDARY_REACH * lengths))
+                np.minimum.at(
+                    h,
+                    (j + dj, i + di),
+                    lengths + rate * np.maximum(0.0, dist - BOUNDARY_REACH * lengths),
+                )
     h = limit_gradation(h, dx, dy, spread if not np.isfinite(h).all() else gradation)
     if not np.isfinite(h).all():
         raise InvalidSizeError("could not derive a size from the boundary")

@@ -8,6 +8,7 @@ Delaunay triangulation of its own vertices and segments, a cut piece being a seg
 there; once the cut pieces are ordinary edges, Lawson flips starting from them make
 the whole mesh the CDT of its vertices and the input segments again.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -97,12 +98,12 @@ def stitch_parts(meshes, input_xy: np.ndarray, input_markers: np.ndarray):
     is_input = seg_key[sp] == joined
     cut = np.c_[t[hit][~is_input], k[hit][~is_input]]
     cut_vertices = np.setdiff1d(np.unique(np.c_[a[hit], b[hit]][~is_input]), segments)
-    return (points, T, N, R, segments, input_markers, cut, cut_vertices,
-            set(seg_key.tolist()))
+    return (points, T, N, R, segments, input_markers, cut, cut_vertices, set(seg_key.tolist()))
 
 
-def lawson_flips(P: np.ndarray, T: np.ndarray, N: np.ndarray, constrained: set,
-                 start: np.ndarray) -> int:
+def lawson_flips(
+    P: np.ndarray, T: np.ndarray, N: np.ndarray, constrained: set, start: np.ndarray
+) -> int:
     """Flip non-Delaunay edges, starting from the half-edges ``start`` (t, k), until
     every edge reached is locally Delaunay or a constrained edge (``constrained``
     holds keys lo * n + hi).  T and N are changed in place; returns the flip count.
@@ -123,8 +124,7 @@ def lawson_flips(P: np.ndarray, T: np.ndarray, N: np.ndarray, constrained: set,
             continue
         j = next(i for i in range(3) if int(T[u, i]) != a and int(T[u, i]) != b)
         d = int(T[u, j])
-        if incircle(P[c, 0], P[c, 1], P[a, 0], P[a, 1], P[b, 0], P[b, 1],
-                    P[d, 0], P[d, 1]) <= 0:
+        if incircle(P[c, 0], P[c, 1], P[a, 0], P[a, 1], P[b, 0], P[b, 1], P[d, 0], P[d, 1]) <= 0:
             continue
         n_bc, n_ca = int(N[t, (k + 1) % 3]), int(N[t, (k + 2) % 3])
         n_ad, n_db = int(N[u, (j + 1) % 3]), int(N[u, (j + 2) % 3])

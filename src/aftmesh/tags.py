@@ -12,6 +12,7 @@ input edge it lies on, so a side split into many pieces keeps its name.
 >>> tags.tolist(), names
 ([0, 0, 2, 1], {'left': 1, 'top': 2})
 """
+
 from __future__ import annotations
 
 from collections.abc import Mapping
@@ -31,29 +32,36 @@ def _select(name: str, selector, mids: np.ndarray) -> np.ndarray:
             out = selector(np.ascontiguousarray(mids[:, 0]), np.ascontiguousarray(mids[:, 1]))
         except Exception as exc:
             raise InvalidOptionError(
-                f"boundary_tags[{name!r}] raised {type(exc).__name__}: {exc}") from exc
+                f"boundary_tags[{name!r}] raised {type(exc).__name__}: {exc}"
+            ) from exc
         picked = np.asarray(out)
         if picked.ndim == 0:
             picked = np.full(n, bool(picked))
         if picked.shape != (n,) or picked.dtype != bool:
             raise InvalidOptionError(
                 f"boundary_tags[{name!r}] must return a boolean array of length {n} (one "
-                f"per input edge midpoint), got dtype {picked.dtype}, shape {picked.shape}")
+                f"per input edge midpoint), got dtype {picked.dtype}, shape {picked.shape}"
+            )
         return picked
     try:
         index = np.asarray(selector)
     except (TypeError, ValueError):
         index = None
-    if index is None or index.ndim != 1 or not (
-            index.size == 0 or np.issubdtype(index.dtype, np.integer)):
+    if (
+        index is None
+        or index.ndim != 1
+        or not (index.size == 0 or np.issubdtype(index.dtype, np.integer))
+    ):
         raise InvalidOptionError(
             f"boundary_tags[{name!r}] must be a callable f(x, y) or a sequence of "
-            f"input-edge indices, got {selector!r}")
+            f"input-edge indices, got {selector!r}"
+        )
     bad = (index < 0) | (index >= n)
     if bad.any():
         raise InvalidOptionError(
             f"boundary_tags[{name!r}] selects input edge {int(index[bad][0])}, but the "
-            f"input edges are numbered 0..{n - 1}")
+            f"input edges are numbered 0..{n - 1}"
+        )
     picked = np.zeros(n, dtype=bool)
     picked[index.astype(np.int64)] = True
     return picked
@@ -68,7 +76,8 @@ def resolve_boundary_tags(boundary_tags, edge_midpoints, describe=None):
     if not isinstance(boundary_tags, Mapping):
         raise InvalidOptionError(
             "boundary_tags must be a mapping {name: selector}, got "
-            f"{type(boundary_tags).__name__}")
+            f"{type(boundary_tags).__name__}"
+        )
     tags = np.zeros(len(mids), dtype=np.int32)
     names: dict[str, int] = {}
     for k, (name, selector) in enumerate(boundary_tags.items(), start=1):
@@ -82,7 +91,8 @@ def resolve_boundary_tags(boundary_tags, edge_midpoints, describe=None):
             what = f" ({describe(e)})" if describe is not None else ""
             raise InvalidOptionError(
                 f"input edge {e}{what}, midpoint {mids[e].tolist()}, is selected by both "
-                f"boundary_tags {other!r} and {name!r}: each edge gets one tag")
+                f"boundary_tags {other!r} and {name!r}: each edge gets one tag"
+            )
         tags[picked] = k
         names[name] = k
     return tags, names

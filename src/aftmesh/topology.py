@@ -4,6 +4,7 @@ One connected-components routine (:func:`components`, numpy only) serves every
 question here and in :mod:`aftmesh.checks`.  (The kernel's ``Triangulation.components``
 is a different job: it labels the pieces of the CDT before meshing.)
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -107,6 +108,7 @@ def hole_points(mesh) -> np.ndarray:
     ((1, 2), True)
     """
     import shapely
+
     P, T, N = mesh.points, mesh.triangles, mesh.neighbors
     if len(T) == 0:
         return np.zeros((0, 2))

@@ -5,6 +5,7 @@ Real GIS data is often invalid in more than one way at once (a self-touching ext
 and two overlapping holes); the messages list each problem with its own place, so the
 user can find it without a GIS at hand.
 """
+
 from __future__ import annotations
 
 import re
@@ -62,12 +63,16 @@ def _hole_problems(poly: Polygon) -> list[str]:
             continue
         common = valid[i].intersection(valid[j])
         if common.area > 0:
-            problems.append(f"holes {index[i]} and {index[j]} overlap at "
-                            f"{_xy(*common.representative_point().coords[0])}")
+            problems.append(
+                f"holes {index[i]} and {index[j]} overlap at "
+                f"{_xy(*common.representative_point().coords[0])}"
+            )
         elif common.geom_type != "Point":
             p = shapely.get_coordinates(common)[0]
-            problems.append(f"holes {index[i]} and {index[j]} touch along a line or at "
-                            f"more than one point, at {_xy(*p)}")
+            problems.append(
+                f"holes {index[i]} and {index[j]} touch along a line or at "
+                f"more than one point, at {_xy(*p)}"
+            )
     return problems
 
 
@@ -132,13 +137,19 @@ def check_lines_inside(polygons, lines, line_names, points, tolerance: float = 0
         if union.covers(line):
             continue
         if tol is None:
-            tol = max(tolerance, snap_tolerance(np.concatenate(
-                [shapely.get_coordinates(g) for g in (*polygons, *lines)])))
+            tol = max(
+                tolerance,
+                snap_tolerance(
+                    np.concatenate([shapely.get_coordinates(g) for g in (*polygons, *lines)])
+                ),
+            )
         if not _outside_by_rounding(line.difference(union), union, tol):
             p = _leaves_at(line, union)
             raise InvalidDomainError(
-                f"{name} is not inside the domain: it leaves the domain at {_xy(*p)}")
+                f"{name} is not inside the domain: it leaves the domain at {_xy(*p)}"
+            )
     for k, p in enumerate(points):
         if not union.covers(p):
             raise InvalidDomainError(
-                f"fixed point {k} = {list(p.coords)[0]} is not inside the domain")
+                f"fixed point {k} = {list(p.coords)[0]} is not inside the domain"
+            )
