@@ -7,14 +7,14 @@ field.  Randomness is seeded, so every run meshes the same domains.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 import numpy as np
 import shapely
 from shapely.geometry import LineString, MultiPolygon, Point, Polygon, box
 
-__all__ = ["Built", "BUILT"]
+__all__ = ["BUILT", "Built"]
 
 SEED = 20261127          # one seed for every random domain: runs compare like with like
 CIRCLE_QUAD_SEGS = 16    # shapely buffer resolution (points per quarter circle)

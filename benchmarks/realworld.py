@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import math
+from itertools import pairwise
 from pathlib import Path
 
 import numpy as np
@@ -52,7 +53,7 @@ def _pieces(a: np.ndarray, b: np.ndarray, h: float, size) -> np.ndarray:
         s = np.linspace(0.0, 1.0, GRADED_SAMPLES + 1)
         mid = a + 0.5 * (s[1:] + s[:-1])[:, None] * (b - a)
         w = np.concatenate([[0.0], np.cumsum(L / GRADED_SAMPLES / size(mid[:, 0], mid[:, 1]))])
-        m = max(1, int(round(w[-1])))
+        m = max(1, round(float(w[-1])))
         t = np.interp(np.arange(1, m) / m * w[-1], w, s)
     return a + t[:, None] * (b - a)
 
@@ -73,11 +74,11 @@ def geometry_to_pslg(geom, h: float, size=None):
 
     for line in getattr(lines, "geoms", [lines]):
         c = np.asarray(line.coords)
-        for a, b in zip(c[:-1], c[1:]):
+        for a, b in pairwise(c):
             if a[0] == b[0] and a[1] == b[1]:
                 continue
             chain = [vid(a), *(vid(p) for p in _pieces(a, b, h, size)), vid(b)]
-            for u, v in zip(chain[:-1], chain[1:]):
+            for u, v in pairwise(chain):
                 segs.add((min(u, v), max(u, v)))
     V = np.array(verts, dtype=np.float64)
     S = np.array(sorted(segs), dtype=np.int32)
@@ -97,7 +98,7 @@ def geometry_to_case(name: str, description: str, geom, h: float, size=None,
 
 def build_realworld(name: str) -> Case:
     """A case of the group by name (``rw-<outline>`` or ``rw-<built domain>``)."""
-    base = name[len(PREFIX):] if name.startswith(PREFIX) else name
+    base = name.removeprefix(PREFIX)
     if base in BUILT:
         b = BUILT[base]()
         return geometry_to_case(name, b.description, b.geometry, b.h, b.size, b.gmsh_size_expr)
@@ -133,8 +134,8 @@ def summary_table(sec: dict) -> str:
             r = by.get((cname, m), {})
             s = r.get("stats")
             if not s or "median" not in r:
-                for k in cells:
-                    cells[k].append("err" if "error" in r else "-")
+                for column in cells.values():
+                    column.append("err" if "error" in r else "-")
                 continue
             sums[m].append((s["rr_mean"], s["rr_above_0.9"], s["min_angle"]))
             cells["rr"].append(f"{s['rr_mean']:.4f}")

@@ -31,6 +31,7 @@ include "cdt.pxi"
 include "sizing.pxi"
 include "front.pxi"
 include "smoothing.pxi"
+include "optimize.pxi"
 
 
 class KernelError(RuntimeError):

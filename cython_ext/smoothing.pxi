@@ -1,10 +1,10 @@
 # Smoothing after the front has closed (optional, on by default in generate()).
 #
-# Each pass moves every vertex that Basic_aft created (the input vertices never move)
-# to the best of a few candidate places, judged by the worst shape of its triangles,
-# when that keeps them all counter-clockwise (exact orient2d), and then restores the constrained Delaunay
-# property by Lawson flips over the whole mesh, so the result is still the CDT of its
-# vertices and the input edges.
+# Each pass moves vertices that Basic_aft created (the input vertices never move) by
+# optimize.pxi's _optimize_vertex, which keeps every triangle counter-clockwise (exact
+# orient2d) and restores the constrained Delaunay property by Lawson flips around each
+# moved vertex, so the result is still the CDT of its vertices and the input edges.
+# (_smooth_vertex below is the earlier max-min move, kept for comparison.)
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
     """4 sqrt(3) area / (sum of squared edge lengths): 1 for an equilateral triangle,
@@ -121,28 +121,21 @@ cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
 
 
 cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
-    """Up to `passes` rounds of smoothing of vertices first_movable.. and Delaunay
-    flips, stopping early when a round moves nothing; signals are checked after each
-    round.  Returns the number of vertex moves, or an error."""
-    cdef int p, v, t, k, n, res, moved = 0, moved_now
+    """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), each
+    followed by Delaunay flips around the vertex, stopping early when a round moves
+    nothing; signals are checked after each round.  Returns the number of vertex
+    moves, or an error."""
+    cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
         for v in range(first_movable, T.nv):
-            moved_now += _smooth_vertex(T, v)
+            res = _optimize_vertex(T, v)
+            if res < 0:
+                return res
+            moved_now += res
         moved += moved_now
         if check_signals(A) != 0:
             return ERR_INTERRUPTED
         if moved_now == 0:
             break
-        if reserve_stack(T, 3 * T.nt):
-            return ERR_NOMEM
-        n = 0
-        for t in range(T.nt):
-            if T.tstate[t] == T_MESHED:
-                for k in range(3):
-                    T.stack[n] = 3 * t + k
-                    n += 1
-        res = legalize_meshed(T, n)
-        if res < 0:
-            return res
     return moved

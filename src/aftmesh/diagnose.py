@@ -37,7 +37,7 @@ from .aft import Strategy
 from .generate import generate
 from .mesh import Mesh, triangle_quality
 
-__all__ = ["Diagnosis", "diagnose", "CLASSES"]
+__all__ = ["CLASSES", "Diagnosis", "diagnose"]
 
 CLASSES = ("smoothing", "boundary", "size", "collision", "other")
 SIZE_RATIO = 1.3         # size field max / min over one triangle: a transition
@@ -89,8 +89,8 @@ class Diagnosis:
 
     def summary(self) -> str:
         n = len(self.mesh.triangles)
-        lines = [f"{len(self.bad)} of {n} triangles have RR < {self.threshold:g} "
-                 f"({100 * len(self.bad) / max(n, 1):.2f} %)"]
+        share = 100 * len(self.bad) / max(n, 1)
+        lines = [f"{len(self.bad)} of {n} triangles have RR < {self.threshold:g} ({share:.2f} %)"]
         for c in CLASSES:
             k = self.counts.get(c, 0)
             lines.append(f"  {c:10s} {k:7d}  {100 * k / max(len(self.bad), 1):5.1f} %")
