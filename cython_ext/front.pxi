@@ -225,8 +225,8 @@ cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
 cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
     """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
     distance from a and b that the local size asks for (an equilateral triangle when
-    |E| equals the size), kept between 0.55 |E| and 2 |E| so that the triangle's shape
-    stays reasonable where the size changes faster than the front."""
+    |E| equals the size), kept between R_SIDE_MIN |E| and R_SIDE_MAX |E| so that the
+    triangle's shape stays good where the size changes faster than the front."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
@@ -247,11 +247,19 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     h_out[0] = h
 
 
+# R's distance from the ends of E stays within these multiples of |E|: the triangle
+# T(E, R) is then never far from equilateral (radius ratio >= 0.88), and where the
+# size differs from |E| it is reached over a few layers (about 1.35 per layer, near
+# the default gradation) instead of by one stretched or flattened triangle.
+cdef double R_SIDE_MIN = 0.75
+cdef double R_SIDE_MAX = 1.35
+
+
 cdef inline double _side_length(double h, double L) noexcept nogil:
-    if h < 0.55 * L:
-        return 0.55 * L
-    if h > 2.0 * L:
-        return 2.0 * L
+    if h < R_SIDE_MIN * L:
+        return R_SIDE_MIN * L
+    if h > R_SIDE_MAX * L:
+        return R_SIDE_MAX * L
     return h
 
 
