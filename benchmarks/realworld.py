@@ -118,39 +118,46 @@ GROUP_MESHERS = ["aft", "gmsh-frontal", "tri-pq30"]
 _SHORT = {"aft": "aft", "gmsh-frontal": "Gmsh6", "tri-pq30": "Tri"}
 
 
+def _cells(r: dict) -> list[str] | None:
+    s = r.get("stats")
+    if not s or "median" not in r:
+        return None
+    return [f"{s['rr_mean']:.4f}", f"{100 * s['rr_above_0.9']:.1f}", f"{s['min_angle']:.1f}",
+            str(s["triangles"]), f"{r['median']:.3g}"]
+
+
 def summary_table(sec: dict) -> str:
     """Per case: mean RR, % RR > 0.9, min angle, triangles and time of each mesher
-    (aftmesh / Gmsh alg 6 / Triangle pq30a), then the averages over the group."""
+    (aftmesh / Gmsh alg 6 / Triangle pq30a), then the averages over the cases that
+    every mesher meshed (so that a failure does not move one mesher's average)."""
     by = {(r["case"], r["mesher"]): r for r in sec["rows"]}
     meshers = [m for m in GROUP_MESHERS if any(k[1] == m for k in by)]
     lab = " / ".join(_SHORT[m] for m in meshers)
     hdr = (f"| case | RR mean {lab} | % RR > 0.9 {lab} | min angle {lab} | triangles {lab} | "
            f"time {lab} |")
     out = [hdr, "|" + "---|" * 6]
-    sums: dict[str, list] = {m: [] for m in meshers}
+    common, missing = [], []
     for cname in dict.fromkeys(r["case"] for r in sec["rows"]):
-        cells = {k: [] for k in ("rr", "pct", "ang", "n", "t")}
-        for m in meshers:
-            r = by.get((cname, m), {})
-            s = r.get("stats")
-            if not s or "median" not in r:
-                for column in cells.values():
-                    column.append("err" if "error" in r else "-")
-                continue
-            sums[m].append((s["rr_mean"], s["rr_above_0.9"], s["min_angle"]))
-            cells["rr"].append(f"{s['rr_mean']:.4f}")
-            cells["pct"].append(f"{100 * s['rr_above_0.9']:.1f}")
-            cells["ang"].append(f"{s['min_angle']:.1f}")
-            cells["n"].append(str(s["triangles"]))
-            cells["t"].append(f"{r['median']:.3g}")
-        out.append(f"| {cname} | " + " | ".join(" / ".join(cells[k]) for k in cells) + " |")
+        cells = [_cells(by.get((cname, m), {})) for m in meshers]
+        if all(cells):
+            common.append(cname)
+        else:
+            missing.append(cname)
+        cols = zip(*[c or ["err"] * 5 for c in cells])
+        out.append(f"| {cname} | " + " | ".join(" / ".join(col) for col in cols) + " |")
     avg = []
     for m in meshers:
-        a = np.array(sums[m]) if sums[m] else np.full((1, 3), np.nan)
-        avg.append(a.mean(axis=0))
-    out.append("| **average** | " + " / ".join(f"{a[0]:.4f}" for a in avg) + " | "
+        st = [by[(c, m)]["stats"] for c in common]
+        avg.append([np.mean([s[k] for s in st]) if st else np.nan
+                    for k in ("rr_mean", "rr_above_0.9", "min_angle", "triangles")])
+    out.append(f"| **average ({len(common)} cases)** | "
+               + " / ".join(f"{a[0]:.4f}" for a in avg) + " | "
                + " / ".join(f"{100 * a[1]:.1f}" for a in avg) + " | "
-               + " / ".join(f"{a[2]:.1f}" for a in avg) + " | - | - |")
+               + " / ".join(f"{a[2]:.1f}" for a in avg) + " | "
+               + " / ".join(f"{a[3]:.0f}" for a in avg) + " | - |")
+    if missing:
+        out.append("")
+        out.append(f"Left out of the averages (a mesher failed): {', '.join(missing)}.")
     return "\n".join(out) + "\n"
 
 
