@@ -225,8 +225,9 @@ cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
 cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
     """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
     distance from a and b that the local size asks for (an equilateral triangle when
-    |E| equals the size), kept between R_SIDE_MIN |E| and R_SIDE_MAX |E| so that the
-    triangle's shape stays good where the size changes faster than the front."""
+    |E| equals the size), kept between R_SIDE_MIN |E| and R_SIDE_MAX |E| (see
+    _side_length) so that the triangle's shape stays good where the size changes
+    faster than the front."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
@@ -251,13 +252,20 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
 # T(E, R) is then never far from equilateral (radius ratio >= 0.88), and where the
 # size differs from |E| it is reached over a few layers (about 1.35 per layer, near
 # the default gradation) instead of by one stretched or flattened triangle.
+# Where the size is more than R_SIDE_FAR |E| (a short input edge in a coarse region) R
+# goes out to R_SIDE_FAR_LENGTH |E| instead: at 1.35 per layer the many layers needed to grow crowd
+# each other where fronts meet (slivers at a sharp trailing edge).
 cdef double R_SIDE_MIN = 0.75
 cdef double R_SIDE_MAX = 1.35
+cdef double R_SIDE_FAR = 3.0
+cdef double R_SIDE_FAR_LENGTH = 2.0
 
 
 cdef inline double _side_length(double h, double L) noexcept nogil:
     if h < R_SIDE_MIN * L:
         return R_SIDE_MIN * L
+    if h > R_SIDE_FAR * L:
+        return R_SIDE_FAR_LENGTH * L
     if h > R_SIDE_MAX * L:
         return R_SIDE_MAX * L
     return h
