@@ -252,9 +252,9 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
 # T(E, R) is then never far from equilateral (radius ratio >= 0.88), and where the
 # size differs from |E| it is reached over a few layers (about 1.35 per layer, near
 # the default gradation) instead of by one stretched or flattened triangle.
-# Where the size is more than R_SIDE_FAR |E| (a short input edge in a coarse region) R
-# goes out to R_SIDE_FAR_LENGTH |E| instead: at 1.35 per layer the many layers needed to grow crowd
-# each other where fronts meet (slivers at a sharp trailing edge).
+# Where the size is more than R_SIDE_FAR |E| (a short input edge in a coarse region),
+# R goes out to R_SIDE_FAR_LENGTH |E| instead: at 1.35 per layer, the many layers
+# needed to grow crowd each other where fronts meet (slivers at a sharp trailing edge).
 cdef double R_SIDE_MIN = 0.75
 cdef double R_SIDE_MAX = 1.35
 cdef double R_SIDE_FAR = 3.0
