@@ -107,6 +107,11 @@ def parse_args(argv):
         action="store_true",
         help="run nothing: rebuild results.md (and the README block) from out/results.json",
     )
+    p.add_argument(
+        "--realworld",
+        action="store_true",
+        help="the real-world group only: a compact quality table (see realworld.py)",
+    )
     p.add_argument("--list", action="store_true", help="list cases and meshers and exit")
     p.add_argument("--out", type=Path, default=OUT, help="output folder (default benchmarks/out)")
     return p.parse_args(argv)
@@ -127,6 +132,9 @@ def _main(argv) -> int:
     if args.list:
         print("cases:  ", " ".join(_cases.case_names()))
         print("quick:  ", " ".join(_cases.QUICK_CASES))
+        from .realworld import REALWORLD_CASES
+
+        print("realworld:", " ".join(REALWORLD_CASES))
         for k, (_label, desc) in MESHERS.items():
             print(f"mesher:  {k:14s} {desc}")
         return 0
@@ -137,6 +145,9 @@ def _main(argv) -> int:
 
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
+    if args.realworld:
+        from .realworld import run_group
+        return run_group(args, out)
     store = out / "results.json"
     results = {}
     if store.exists():

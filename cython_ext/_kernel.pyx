@@ -44,6 +44,7 @@ include "sizing.pxi"
 include "ordering.pxi"
 include "front.pxi"
 include "smoothing.pxi"
+include "optimize.pxi"
 
 
 class KernelError(RuntimeError):

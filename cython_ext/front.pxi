@@ -24,11 +24,6 @@ from libc.stdlib cimport malloc, free
 from libc.string cimport memset
 
 # Tuning constants of the compiled loop (each with the reason for its value).
-# Compute_new_candidate keeps |R - a| = |R - b| between these multiples of |E|: below
-# 0.55 |E| the new triangle's apex angle would exceed about 130 degrees, above 2 |E| its
-# base angles would exceed about 75 degrees, where the size grows faster than the front.
-cdef double SIDE_MIN_FACTOR = 0.55
-cdef double SIDE_MAX_FACTOR = 2.0
 # Get_next_edge compares lengths in classes of 2**(1/8) (about 9 %): the key is
 # floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(|E|^2)), i.e. eighths of an octave of |E|.
 cdef double LENGTH_CLASSES_PER_OCTAVE_SQ = 4.0
@@ -212,9 +207,9 @@ cdef inline int compute_existing_candidate(Tri* T, int e) noexcept nogil:
 cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out) noexcept nogil:
     """The ideal point R on the left of E = a->b: on the perpendicular bisector, at the
     distance from a and b that the local size asks for (an equilateral triangle when
-    |E| equals the size), kept between SIDE_MIN_FACTOR |E| and SIDE_MAX_FACTOR |E| so
-    that the triangle's shape stays reasonable where the size changes faster than the
-    front."""
+    |E| equals the size), kept between R_SIDE_MIN |E| and R_SIDE_MAX |E| (see
+    _side_length) so that the triangle's shape stays good where the size changes
+    faster than the front."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
@@ -235,11 +230,26 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     h_out[0] = h
 
 
+# R's distance from the ends of E stays within these multiples of |E|: the triangle
+# T(E, R) is then never far from equilateral (radius ratio >= 0.88), and where the
+# size differs from |E| it is reached over a few layers (about 1.35 per layer, near
+# the default gradation) instead of by one stretched or flattened triangle.
+# Where the size is more than R_SIDE_FAR |E| (a short input edge in a coarse region),
+# R goes out to R_SIDE_FAR_LENGTH |E| instead: at 1.35 per layer, the many layers
+# needed to grow crowd each other where fronts meet (slivers at a sharp trailing edge).
+cdef double R_SIDE_MIN = 0.75
+cdef double R_SIDE_MAX = 1.35
+cdef double R_SIDE_FAR = 3.0
+cdef double R_SIDE_FAR_LENGTH = 2.0
+
+
 cdef inline double _side_length(double h, double L) noexcept nogil:
-    if h < SIDE_MIN_FACTOR * L:
-        return SIDE_MIN_FACTOR * L
-    if h > SIDE_MAX_FACTOR * L:
-        return SIDE_MAX_FACTOR * L
+    if h < R_SIDE_MIN * L:
+        return R_SIDE_MIN * L
+    if h > R_SIDE_FAR * L:
+        return R_SIDE_FAR_LENGTH * L
+    if h > R_SIDE_MAX * L:
+        return R_SIDE_MAX * L
     return h
 
 

@@ -1,26 +1,17 @@
 # Smoothing after the front has closed (optional, on by default in generate()).
 #
-# Each pass moves every vertex that Basic_aft created (the input vertices never move)
-# to the best of a few candidate places, judged by the worst shape of its triangles,
-# when that keeps them all counter-clockwise (exact orient2d), and then restores the
-# constrained Delaunay property by Lawson flips over the whole mesh, so the result is
-# still the CDT of its
-# vertices and the input edges.  Flips never touch constrained edges, so every input
-# segment keeps its pieces and their ids (eseg).
+# Each pass moves vertices that Basic_aft created (the input vertices never move) by
+# optimize.pxi's _optimize_vertex, which keeps every triangle counter-clockwise (exact
+# orient2d) and restores the constrained Delaunay property by Lawson flips around each
+# moved vertex, so the result is still the CDT of its vertices and the input edges.
 #
-# Uses: halfedge.pxd; aft.pxd (Aft); predicates.pxi (orient2d); triangulation.pxi
-# (legalize_meshed, reserve_stack); front.pxi (check_signals).
+# _shape is the quality measure optimize.pxi's moves are judged by.
+#
+# Uses: halfedge.pxd; aft.pxd (Aft); front.pxi (check_signals); optimize.pxi
+# (_optimize_vertex).
 from halfedge cimport *
 from aft cimport Aft
 
-# A vertex whose triangles all have a shape above this is left alone: nearly all are,
-# after Basic_aft, and the skip saves most of the work of a pass.
-cdef double SMOOTH_SKIP_SHAPE = 0.985
-# A candidate place must beat the current worst shape by this much, so that rounding
-# noise alone never moves a vertex (and the passes stop).
-cdef double SMOOTH_MIN_GAIN = 1e-6
-cdef enum:
-    SMOOTH_MAX_DEGREE = 64      # a vertex with more triangles than this is not moved
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
     """4 sqrt(3) area / (sum of squared edge lengths): 1 for an equilateral triangle,
@@ -33,132 +24,22 @@ cdef inline double _shape(const double* a, const double* b, const double* c) noe
     return 3.4641016151377544 * area2 / s
 
 
-cdef double _worst_around(Tri* T, int e0) noexcept nogil:
-    cdef int e = e0
-    cdef double q, worst = 2.0
-    while True:
-        q = _shape(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]))
-        if q < worst:
-            worst = q
-        e = T.twin[prv(e)]
-        if e == e0:
-            return worst
-
-
-cdef double _try_at(Tri* T, int v, int e0, double x, double y) noexcept nogil:
-    """Worst shape around v if it stood at (x, y) (v is put back afterwards)."""
-    cdef double ox = T.xy[2 * v], oy = T.xy[2 * v + 1], q
-    T.xy[2 * v] = x
-    T.xy[2 * v + 1] = y
-    q = _worst_around(T, e0)
-    T.xy[2 * v] = ox
-    T.xy[2 * v + 1] = oy
-    return q
-
-
-cdef int _smooth_vertex(Tri* T, int v) noexcept nogil:
-    """Move v to whichever of a few candidate places makes the worst of its triangles
-    best: the mean of its neighbours (Laplacian), the mean of its triangles' ideal
-    apexes (each the point that would make that triangle equilateral on its edge
-    opposite v), and two steps towards the ideal apex of its worst triangle.  The move
-    is kept only if it improves the worst shape (so smoothing never makes the worst
-    triangle around a vertex worse) and every triangle stays counter-clockwise (exact
-    orient2d).  A vertex whose triangles are all nearly equilateral (SMOOTH_SKIP_SHAPE) is
-    left alone: most are, which saves most of the work.  Returns 1 if v moved."""
-    cdef int e0 = T.vhe[v], e = e0, guard = 0, n = 0, u, w, k
-    cdef double lx = 0.0, ly = 0.0, ix = 0.0, iy = 0.0, ax, ay, mx, my, q, worst_q = 2.0
-    cdef double wx = 0.0, wy = 0.0, best, bx, by, cx, cy, t
-    cdef double* pu
-    cdef double* pw
-    if e0 < 0:
-        return 0
-    while True:
-        u = T.tv[nxt(e)]
-        w = T.tv[prv(e)]
-        if u < 0 or w < 0 or T.tstate[e // 3] != T_MESHED:
-            return 0                # on the hull or next to the outside: keep it
-        pu = P(T, u)
-        pw = P(T, w)
-        # the equilateral apex on edge u->w, on v's side (left of u->w)
-        mx = 0.5 * (pu[0] + pw[0])
-        my = 0.5 * (pu[1] + pw[1])
-        ax = mx - 0.8660254037844386 * (pw[1] - pu[1])
-        ay = my + 0.8660254037844386 * (pw[0] - pu[0])
-        lx += pu[0]
-        ly += pu[1]
-        ix += ax
-        iy += ay
-        q = _shape(P(T, v), pu, pw)
-        if q < worst_q:
-            worst_q = q
-            wx = ax
-            wy = ay
-        n += 1
-        e = T.twin[prv(e)]
-        guard += 1
-        if e == e0:
-            break
-        if guard > SMOOTH_MAX_DEGREE:
-            return 0
-    if worst_q > SMOOTH_SKIP_SHAPE:
-        return 0                    # all its triangles are nearly equilateral already
-    best = worst_q
-    bx = T.xy[2 * v]
-    by = T.xy[2 * v + 1]
-    cx = bx
-    cy = by
-    for k in range(4):
-        if k == 0:
-            ax, ay = lx / n, ly / n
-        elif k == 1:
-            ax, ay = ix / n, iy / n
-        else:
-            t = 0.25 if k == 2 else 0.5
-            ax = cx + t * (wx - cx)
-            ay = cy + t * (wy - cy)
-        q = _try_at(T, v, e0, ax, ay)
-        if q > best + SMOOTH_MIN_GAIN:
-            best = q
-            bx = ax
-            by = ay
-    if bx == cx and by == cy:
-        return 0
-    T.xy[2 * v] = bx
-    T.xy[2 * v + 1] = by
-    e = e0
-    while True:
-        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
-            T.xy[2 * v] = cx
-            T.xy[2 * v + 1] = cy
-            return 0
-        e = T.twin[prv(e)]
-        if e == e0:
-            return 1
-
-
 cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
-    """Up to `passes` rounds of smoothing of vertices first_movable.. and Delaunay
-    flips, stopping early when a round moves nothing; signals are checked after each
-    round.  Returns the number of vertex moves, or an error."""
-    cdef int p, v, t, k, n, res, moved = 0, moved_now
+    """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), each
+    followed by Delaunay flips around the vertex, stopping early when a round moves
+    nothing; signals are checked after each round.  Returns the number of vertex
+    moves, or an error."""
+    cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
         for v in range(first_movable, T.nv):
-            moved_now += _smooth_vertex(T, v)
+            res = _optimize_vertex(T, v)
+            if res < 0:
+                return res
+            moved_now += res
         moved += moved_now
         if check_signals(A) != 0:
             return ERR_INTERRUPTED
         if moved_now == 0:
             break
-        if reserve_stack(T, 3 * T.nt):
-            return ERR_NOMEM
-        n = 0
-        for t in range(T.nt):
-            if T.tstate[t] == T_MESHED:
-                for k in range(3):
-                    T.stack[n] = 3 * t + k
-                    n += 1
-        res = legalize_meshed(T, n)
-        if res < 0:
-            return res
     return moved

@@ -75,12 +75,14 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         than ``close_factor * h`` (a constrained edge: half that).
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
-        for every vertex Basic_aft created, a few places (the mean of its neighbours,
-        the mean of the apexes that would make its triangles equilateral, steps
-        towards the ideal apex of its worst triangle) and moves it to the one that
-        makes the worst of its triangles best, only if that improves on where it is
-        and keeps every triangle counter-clockwise; then edge swaps restore the
-        constrained Delaunay property.  Input vertices never move.
+        for every vertex Basic_aft created whose triangles are not all nearly
+        equilateral, a few places (the mean of its neighbours, the mean of the apexes
+        that would make its triangles equilateral, the optimal-Delaunay point, steps
+        towards its worst triangle's ideal apex, then a gradient step) and moves it
+        to the one that lowers the sum of 1/shape^2 of its triangles without making
+        the worst of them worse, keeping every triangle counter-clockwise (exact);
+        edge swaps around it then restore the constrained Delaunay property.  Input
+        vertices never move.
         ``info['smoothing_moves']`` counts the moves.
     strategy : Strategy, optional
         Subtasks to plug in (see :class:`aftmesh.aft.Strategy`); the Python loop runs

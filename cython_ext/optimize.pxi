@@ -1,0 +1,243 @@
+# Optimization-based vertex moves for smooth() (smoothing.pxi).
+#
+# A vertex that Basic_aft created moves to the place that most lowers the cost of its
+# triangles, the sum of 1 / shape^2 (shape: _shape(), 1 when equilateral), among a few
+# candidates: the mean of its neighbours, the mean of its triangles' ideal apexes, the
+# optimal-Delaunay (ODT) point (the area-weighted mean of its triangles'
+# circumcentres), steps towards the ideal apex of its worst triangle, and then a short
+# descent along the cost's gradient.  The cost is dominated by the worst triangle but,
+# unlike the worst shape alone, it also rewards improving the others, so a vertex next
+# to a triangle no move can mend (a short input edge) still settles the rest.  A move
+# is kept only when it lowers the cost, does not lower the worst shape around the
+# vertex and leaves every triangle counter-clockwise (exact orient2d), and then Lawson
+# flips restore the CDT around it at once: only the edges of its triangles can have
+# become illegal, and each next vertex is judged on the swapped mesh.
+
+cdef enum:
+    OPT_RING_CAP = 64           # a vertex of more triangles than this is left alone
+
+# a vertex whose triangles all have a shape above this is left alone (most are, which
+# saves most of the work); shape 0.985 is a radius ratio of about 0.97
+cdef double OPT_SKIP = 0.985
+# numerical gradient: step, as a fraction of the mean edge length around the vertex
+cdef double OPT_GRAD_STEP = 1e-4
+# descent steps tried along the negative gradient, as fractions of the mean edge length
+cdef double[4] OPT_DESCENT = [0.2, 0.08, 0.03, 0.01]
+# a cost this large means a triangle turned over (or went flat) at the trial place
+cdef double OPT_INVALID = 1e300
+
+
+cdef double _ring_cost(Tri* T, int e0, double* worst) noexcept nogil:
+    """Sum of 1 / shape^2 over the triangles around the origin of e0 (OPT_INVALID if
+    one is flat or inverted in floating point); the worst shape goes to worst[0]."""
+    cdef int e = e0
+    cdef double q, cost = 0.0
+    worst[0] = 2.0
+    while True:
+        q = _shape(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]))
+        if q < worst[0]:
+            worst[0] = q
+        if q <= 0.0:
+            return OPT_INVALID
+        cost += 1.0 / (q * q)
+        e = T.twin[prv(e)]
+        if e == e0:
+            return cost
+
+
+cdef double _cost_at(Tri* T, int v, int e0, double x, double y,
+                     double* worst) noexcept nogil:
+    """_ring_cost with v standing at (x, y) (v is put back afterwards)."""
+    cdef double ox = T.xy[2 * v], oy = T.xy[2 * v + 1], c
+    T.xy[2 * v] = x
+    T.xy[2 * v + 1] = y
+    c = _ring_cost(T, e0, worst)
+    T.xy[2 * v] = ox
+    T.xy[2 * v + 1] = oy
+    return c
+
+
+cdef inline void _circumcentre(const double* a, const double* b, const double* c,
+                               double* out) noexcept nogil:
+    cdef double bx = b[0] - a[0], by = b[1] - a[1], cx = c[0] - a[0], cy = c[1] - a[1]
+    cdef double d = 2.0 * (bx * cy - by * cx)
+    cdef double b2 = bx * bx + by * by, c2 = cx * cx + cy * cy
+    out[0] = a[0] + (cy * b2 - by * c2) / d
+    out[1] = a[1] + (bx * c2 - cx * b2) / d
+
+
+cdef bint _needs_work(Tri* T, int e0) noexcept nogil:
+    """Whether the vertex at the origin of e0 may move and is worth the work: all its
+    triangles meshed (none next to the outside), at most OPT_RING_CAP of them, and one
+    of them shaped worse than OPT_SKIP."""
+    cdef int e = e0, n = 0
+    cdef bint poor = False
+    while True:
+        if T.tv[nxt(e)] < 0 or T.tv[prv(e)] < 0 or T.tstate[e // 3] != T_MESHED:
+            return False
+        if not poor:
+            poor = _shape(P(T, T.tv[e]), P(T, T.tv[nxt(e)]),
+                          P(T, T.tv[prv(e)])) <= OPT_SKIP
+        n += 1
+        e = T.twin[prv(e)]
+        if e == e0:
+            return poor
+        if n >= OPT_RING_CAP:
+            return False
+
+
+cdef int _ring_points(Tri* T, int v, int e0, double* cand, double* worst_q,
+                      double* mean_len) noexcept nogil:
+    """Walk around v once: cand[0:2] Laplacian point, cand[2:4] mean ideal apex,
+    cand[4:6] ODT point, cand[6:8] the ideal apex of the worst triangle.  Returns the
+    number of triangles, or 0 when v must stay (next to a triangle that is not meshed,
+    or too many triangles)."""
+    cdef int e = e0, n = 0, u, w
+    cdef double ax, ay, q, area, wsum = 0.0, lsum = 0.0
+    cdef double cc[2]
+    cdef double* pu
+    cdef double* pw
+    cdef double* pv = P(T, v)
+    for n in range(8):
+        cand[n] = 0.0
+    n = 0
+    worst_q[0] = 2.0
+    while True:
+        u = T.tv[nxt(e)]
+        w = T.tv[prv(e)]
+        if u < 0 or w < 0 or T.tstate[e // 3] != T_MESHED or n >= OPT_RING_CAP:
+            return 0
+        pu = P(T, u)
+        pw = P(T, w)
+        ax = 0.5 * (pu[0] + pw[0]) - 0.8660254037844386 * (pw[1] - pu[1])
+        ay = 0.5 * (pu[1] + pw[1]) + 0.8660254037844386 * (pw[0] - pu[0])
+        cand[0] += pu[0]
+        cand[1] += pu[1]
+        cand[2] += ax
+        cand[3] += ay
+        area = (pu[0] - pv[0]) * (pw[1] - pv[1]) - (pu[1] - pv[1]) * (pw[0] - pv[0])
+        if area > 0.0:
+            _circumcentre(pv, pu, pw, cc)
+            cand[4] += area * cc[0]
+            cand[5] += area * cc[1]
+            wsum += area
+        lsum += sqrt((pu[0] - pv[0]) ** 2 + (pu[1] - pv[1]) ** 2)
+        q = _shape(pv, pu, pw)
+        if q < worst_q[0]:
+            worst_q[0] = q
+            cand[6] = ax
+            cand[7] = ay
+        n += 1
+        e = T.twin[prv(e)]
+        if e == e0:
+            break
+    cand[0] /= n
+    cand[1] /= n
+    cand[2] /= n
+    cand[3] /= n
+    if wsum > 0.0:
+        cand[4] /= wsum
+        cand[5] /= wsum
+    else:
+        cand[4] = cand[0]
+        cand[5] = cand[1]
+    mean_len[0] = lsum / n
+    return n
+
+
+cdef inline bint _better(double cost, double worst, double best_cost,
+                         double worst0) noexcept nogil:
+    """A trial place is better when it lowers the cost without lowering the worst
+    shape below where it started."""
+    return cost < best_cost * (1.0 - 1e-9) and worst >= worst0
+
+
+cdef void _descend(Tri* T, int v, int e0, double L, double worst0, double* bx,
+                   double* by, double* best) noexcept nogil:
+    """Steps from (bx, by) against the cost's numerical gradient, the longest that
+    improves first; updates (bx, by) and best."""
+    cdef double d = OPT_GRAD_STEP * L, gx, gy, g, wq, c, x, y
+    cdef int k
+    gx = (_cost_at(T, v, e0, bx[0] + d, by[0], &wq)
+          - _cost_at(T, v, e0, bx[0] - d, by[0], &wq))
+    gy = (_cost_at(T, v, e0, bx[0], by[0] + d, &wq)
+          - _cost_at(T, v, e0, bx[0], by[0] - d, &wq))
+    g = sqrt(gx * gx + gy * gy)
+    if not (g > 0.0) or g > OPT_INVALID * 1e-10:
+        return                      # flat, or a trial place was invalid
+    for k in range(4):
+        x = bx[0] - OPT_DESCENT[k] * L * gx / g
+        y = by[0] - OPT_DESCENT[k] * L * gy / g
+        c = _cost_at(T, v, e0, x, y, &wq)
+        if _better(c, wq, best[0], worst0):
+            bx[0] = x
+            by[0] = y
+            best[0] = c
+            return
+
+
+cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
+    """Move v to the best of the candidate places (see the top of this file) when that
+    lowers the cost of its triangles without lowering their worst shape, and every
+    triangle stays counter-clockwise by the exact orient2d; then restore the CDT
+    around it.  Returns 1 if v moved, 0 if not, or an error."""
+    cdef int e0 = T.vhe[v], e, k
+    cdef double cand[8]
+    cdef double worst0, wq, L, c, best, x, y, bx, by
+    cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
+    if e0 < 0 or not _needs_work(T, e0):
+        return 0
+    if _ring_points(T, v, e0, cand, &worst0, &L) == 0:
+        return 0
+    best = _ring_cost(T, e0, &wq)
+    if best >= OPT_INVALID:
+        return 0
+    bx = cx
+    by = cy
+    for k in range(5):
+        if k < 3:
+            x = cand[2 * k]
+            y = cand[2 * k + 1]
+        else:
+            c = 0.25 if k == 3 else 0.5
+            x = cx + c * (cand[6] - cx)
+            y = cy + c * (cand[7] - cy)
+        c = _cost_at(T, v, e0, x, y, &wq)
+        if _better(c, wq, best, worst0):
+            best = c
+            bx = x
+            by = y
+    _descend(T, v, e0, L, worst0, &bx, &by, &best)
+    if bx == cx and by == cy:
+        return 0
+    T.xy[2 * v] = bx
+    T.xy[2 * v + 1] = by
+    e = e0
+    while True:
+        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
+            T.xy[2 * v] = cx
+            T.xy[2 * v + 1] = cy
+            return 0
+        e = T.twin[prv(e)]
+        if e == e0:
+            break
+    return _legalize_around(T, v)
+
+
+cdef int _legalize_around(Tri* T, int v) noexcept nogil:
+    """Lawson flips after v moved, starting from the edges of its triangles (the only
+    ones whose four points include v).  Returns 1, or an error."""
+    cdef int e0 = T.vhe[v], e = e0, n = 0, t, res
+    if reserve_stack(T, 3 * OPT_RING_CAP):
+        return ERR_NOMEM
+    while True:
+        t = e // 3
+        T.stack[n] = 3 * t
+        T.stack[n + 1] = 3 * t + 1
+        T.stack[n + 2] = 3 * t + 2
+        n += 3
+        e = T.twin[prv(e)]
+        if e == e0 or n >= 3 * OPT_RING_CAP:
+            break
+    res = legalize_meshed(T, n)
+    return res if res < 0 else 1

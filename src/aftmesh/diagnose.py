@@ -1,0 +1,180 @@
+"""Where do a mesh's bad triangles come from?  A diagnosis for quality work.
+
+:func:`diagnose` meshes a domain twice, once with the Python Basic_aft loop and no
+smoothing (recording every step) and once as asked, and labels each triangle of the
+final mesh whose radius ratio is below a threshold with the first class that applies:
+
+``smoothing``
+    no triangle around any of its vertices was bad before smoothing: the badness
+    appeared when vertices moved (or edges were swapped after the moves).
+``boundary``
+    one of its vertices lies on an input segment (the boundary or an interface).
+``size``
+    a size transition: the size field's largest / smallest value over its vertices and
+    centroid exceeds :data:`SIZE_RATIO`, or its mean edge length and a neighbour's
+    differ by more than :data:`NEIGHBOUR_RATIO`.
+``collision``
+    fronts met there (a heuristic, from the recorded steps): two of its vertices
+    belong to a step that took an existing candidate S making a triangle with one
+    front edge (E joined to a front vertex that is not its neighbour: two fronts
+    bridged) or three (the last triangle of a closing hole); or two of its vertices
+    were created by Update_internal from front edges whose normals differ by more than
+    :data:`OPPOSING_DEGREES` (fronts coming from opposite directions).
+``other``
+    none of these.
+
+It needs the same vertex numbering in both meshes: smoothing moves vertices but
+neither adds nor removes any, and the Python loop gives the compiled loop's mesh.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .aft import Strategy
+from .generate import generate
+from .mesh import Mesh, triangle_quality
+
+__all__ = ["CLASSES", "Diagnosis", "diagnose"]
+
+CLASSES = ("smoothing", "boundary", "size", "collision", "other")
+SIZE_RATIO = 1.3         # size field max / min over one triangle: a transition
+NEIGHBOUR_RATIO = 1.5    # mean edge length of a triangle against a neighbour's
+OPPOSING_DEGREES = 120.0  # front normals this far apart came from opposite sides
+
+
+class _Recorder(Strategy):
+    """The built-in subtasks, plus a record of what each step of the loop did."""
+
+    def __init__(self):
+        self.pending = None
+        self.bridges: list[tuple] = []       # coordinates of T(E, S) for 1- and 3-front steps
+        self.normals: dict[tuple, float] = {}  # new vertex -> angle of E's normal
+
+    def get_next_edge(self, kernel) -> int:
+        self._finish(kernel)
+        E = kernel.get_next_edge()
+        if E >= 0:
+            a, b = kernel.edge(E)
+            nxt = E - 2 if E % 3 == 2 else E + 1
+            prv = E + 2 if E % 3 == 0 else E - 1
+            fronts = 1 + kernel.is_front(nxt) + kernel.is_front(prv)
+            S = kernel.compute_existing_candidate(E)
+            self.pending = (kernel.vertex(a), kernel.vertex(b), kernel.vertex(S), fronts,
+                            kernel.n_vertices)
+        return E
+
+    def _finish(self, kernel) -> None:
+        if self.pending is None:
+            return
+        pa, pb, ps, fronts, nv = self.pending
+        self.pending = None
+        if kernel.n_vertices > nv:            # Update_internal added R
+            self.normals[kernel.vertex(nv)] = math.atan2(pb[0] - pa[0], -(pb[1] - pa[1]))
+        elif fronts != 2:
+            self.bridges.append((pa, pb, ps))
+
+
+@dataclass
+class Diagnosis:
+    """The labelled bad triangles of ``mesh`` (indices into ``mesh.triangles``)."""
+
+    mesh: Mesh
+    threshold: float
+    bad: np.ndarray                       # (k,) triangle indices
+    labels: np.ndarray                    # (k,) class names
+    counts: dict[str, int] = field(default_factory=dict)
+
+    def summary(self) -> str:
+        n = len(self.mesh.triangles)
+        share = 100 * len(self.bad) / max(n, 1)
+        lines = [f"{len(self.bad)} of {n} triangles have RR < {self.threshold:g} ({share:.2f} %)"]
+        for c in CLASSES:
+            k = self.counts.get(c, 0)
+            lines.append(f"  {c:10s} {k:7d}  {100 * k / max(len(self.bad), 1):5.1f} %")
+        return "\n".join(lines)
+
+
+def _vertex_index(points: np.ndarray) -> dict:
+    return {(float(x), float(y)): i for i, (x, y) in enumerate(points)}
+
+
+def _bad_around(tris: np.ndarray, bad: np.ndarray, n_points: int) -> np.ndarray:
+    """For each vertex: is it a corner of a bad triangle?"""
+    out = np.zeros(n_points, dtype=bool)
+    out[tris[bad].ravel()] = True
+    return out
+
+
+def _size_transition(mesh: Mesh, q: dict) -> np.ndarray:
+    p, t = mesh.points, mesh.triangles
+    corners = np.concatenate([p[t], p[t].mean(axis=1, keepdims=True)], axis=1)
+    field_ = mesh.info.get("size_field")
+    hs = np.asarray(field_(corners[..., 0].ravel(), corners[..., 1].ravel())).reshape(-1, 4)
+    by_field = hs.max(axis=1) > SIZE_RATIO * hs.min(axis=1)
+    mean_edge = q["edge_lengths"].mean(axis=1)
+    nb = mesh.neighbors
+    other = np.where(nb >= 0, mean_edge[np.maximum(nb, 0)], mean_edge[:, None])
+    ratio = np.maximum(other / mean_edge[:, None], mean_edge[:, None] / other).max(axis=1)
+    return by_field | (ratio > NEIGHBOUR_RATIO)
+
+
+def _collision(mesh: Mesh, rec: _Recorder, index: dict) -> np.ndarray:
+    n = len(mesh.points)
+    bridged = np.zeros(n, dtype=np.int32)
+    for tri in rec.bridges:
+        ids = [index.get(c) for c in tri]
+        for i in ids:
+            if i is not None:
+                bridged[i] += 1
+    angle = np.full(n, np.nan)
+    for c, a in rec.normals.items():
+        i = index.get(c)
+        if i is not None:
+            angle[i] = a
+    t = mesh.triangles
+    by_bridge = (bridged[t] > 0).sum(axis=1) >= 2
+    a = angle[t]
+    opposing = np.zeros(len(t), dtype=bool)
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        d = np.abs((a[:, i] - a[:, j] + math.pi) % (2 * math.pi) - math.pi)
+        opposing |= np.nan_to_num(d, nan=0.0) > math.radians(OPPOSING_DEGREES)
+    return by_bridge | opposing
+
+
+def diagnose(domain, size=None, *, threshold: float = 0.9, **options) -> Diagnosis:
+    """Mesh ``domain`` with ``generate(domain, size, **options)`` and label its
+    triangles with radius ratio below ``threshold`` by cause (see the module's
+    docstring for the classes and the heuristics).
+
+    Examples
+    --------
+    >>> from shapely.geometry import box
+    >>> d = diagnose(box(0, 0, 1, 1), 0.1, threshold=0.95)
+    >>> sorted(d.counts) == sorted(CLASSES) and sum(d.counts.values()) == len(d.bad)
+    True
+    """
+    rec = _Recorder()
+    plain = generate(domain, size, **{**options, "smooth": 0, "strategy": rec})
+    mesh = generate(domain, size, **options)
+    if len(plain.points) != len(mesh.points):
+        raise RuntimeError("the two meshes have different vertices: cannot compare them")
+    index = _vertex_index(plain.points)
+    q = triangle_quality(mesh.points, mesh.triangles)
+    bad = np.flatnonzero(q["radius_ratio"] < threshold)
+    q0 = triangle_quality(plain.points, plain.triangles)
+    was_bad = _bad_around(plain.triangles, q0["radius_ratio"] < threshold, len(plain.points))
+    on_segment = np.zeros(len(mesh.points), dtype=bool)
+    on_segment[mesh.segments.ravel()] = True
+    t = mesh.triangles[bad]
+    tests = {"smoothing": ~was_bad[t].any(axis=1),
+             "boundary": on_segment[t].any(axis=1),
+             "size": _size_transition(mesh, q)[bad],
+             "collision": _collision(mesh, rec, index)[bad]}
+    labels = np.full(len(bad), "other", dtype=object)
+    for name in reversed(list(tests)):          # the first class that applies wins
+        labels[tests[name]] = name
+    counts = {c: int((labels == c).sum()) for c in CLASSES}
+    return Diagnosis(mesh, threshold, bad, labels.astype(str), counts)

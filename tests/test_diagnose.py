@@ -1,0 +1,41 @@
+"""aftmesh.diagnose: every bad triangle gets exactly one class, by the stated rules."""
+import numpy as np
+from shapely.geometry import Point, box
+
+from aftmesh.diagnose import CLASSES, diagnose
+from aftmesh.mesh import triangle_quality
+
+
+def _domain():
+    # a plate with holes of very different sizes: boundary, size and interior classes
+    plate = box(0.0, 0.0, 2.0, 1.0)
+    for x, y, r in ((0.4, 0.5, 0.2), (1.2, 0.3, 0.02), (1.5, 0.7, 0.05)):
+        plate = plate.difference(Point(x, y).buffer(r, 8))
+    return plate
+
+
+def test_every_bad_triangle_has_one_class(checked):
+    d = diagnose(_domain(), 0.06, threshold=0.95)
+    checked(d.mesh)
+    rr = triangle_quality(d.mesh.points, d.mesh.triangles)["radius_ratio"]
+    assert np.array_equal(d.bad, np.flatnonzero(rr < 0.95))
+    assert len(d.bad) > 0
+    assert set(d.labels) <= set(CLASSES)
+    assert sum(d.counts.values()) == len(d.bad)
+
+
+def test_boundary_class_touches_an_input_segment():
+    d = diagnose(_domain(), 0.06, threshold=0.95)
+    on_segment = np.zeros(len(d.mesh.points), dtype=bool)
+    on_segment[d.mesh.segments.ravel()] = True
+    tris = d.mesh.triangles[d.bad]
+    touching = on_segment[tris].any(axis=1)
+    assert touching[d.labels == "boundary"].all()
+    # boundary outranks size, collision and other: those never touch a segment
+    later = np.isin(d.labels, ["size", "collision", "other"])
+    assert not touching[later].any()
+
+
+def test_without_smoothing_nothing_is_blamed_on_it():
+    d = diagnose(_domain(), 0.06, threshold=0.95, smooth=0)
+    assert d.counts["smoothing"] == 0
