@@ -186,4 +186,13 @@ def run_group(args, out: Path) -> int:
     (out / "realworld.md").write_text(text)
     print()
     print(text)
+    if args.update_readme:
+        from .report import update_readme
+
+        readme = Path(__file__).resolve().parent.parent / "README.md"
+        marks = ("<!-- realworld:start -->", "<!-- realworld:end -->")
+        if update_readme(readme, text, *marks):
+            print(f"updated {readme}")
+        else:
+            print(f"{readme} has no {marks[0]} ... {marks[1]} block: not updated")
     return 0

@@ -328,12 +328,12 @@ def summary(results: dict) -> str:
     return "\n".join(out).rstrip() + "\n"
 
 
-def update_readme(readme: Path, text: str) -> bool:
+def update_readme(readme: Path, text: str, start: str = START, end: str = END) -> bool:
     """Replace the block between the markers; False (and nothing written) without them."""
     content = readme.read_text()
-    if START not in content or END not in content or content.index(START) > content.index(END):
+    if start not in content or end not in content or content.index(start) > content.index(end):
         return False
-    pattern = re.compile(re.escape(START) + r".*?" + re.escape(END), re.S)
-    new = pattern.sub(lambda _: f"{START}\n{text}{END}", content, count=1)
+    pattern = re.compile(re.escape(start) + r".*?" + re.escape(end), re.S)
+    new = pattern.sub(lambda _: f"{start}\n{text}{end}", content, count=1)
     readme.write_text(new)
     return True
