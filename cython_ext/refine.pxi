@@ -465,9 +465,9 @@ cdef bint _split_is_valid(Tri* T, int e, const double* m) noexcept nogil:
 
 
 cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
-    """Accept m, or move it by a few ulps toward the meshed side of e's edge: a point
-    an ulp outside a segment of the domain's boundary can invert the sliver of exterior
-    triangle behind it (m is then a few ulps inside the domain instead)."""
+    """Accept m, or move it by a few ulps to either side of e's edge: a point an ulp
+    off a segment of the domain's boundary can invert the sliver of exterior triangle
+    behind it."""
     cdef double* a = P(T, T.tv[e])
     cdef double* b = P(T, T.tv[nxt(e)])
     cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h
@@ -475,26 +475,32 @@ cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
     cdef int k
     if _split_is_valid(T, e, m):
         return True
-    if T.tstate[e // 3] != T_MESHED:
-        nx = -nx
-        ny = -ny                    # toward the meshed side, left of e or of its twin
     h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
-    for k in range(1, 5):
-        m[0] = x0 + k * h * nx
-        m[1] = y0 + k * h * ny
+    for k in range(1, 9):
+        # 1, -1, 2, -2, ... ulps along the normal
+        m[0] = x0 + ((k + 1) // 2) * (1 if k % 2 else -1) * h * nx
+        m[1] = y0 + ((k + 1) // 2) * (1 if k % 2 else -1) * h * ny
         if _split_is_valid(T, e, m):
             return True
     return False
 
 
 cdef bint _choose_split(Refine* R, Tri* T, int e, int u, int w, double* m) noexcept nogil:
-    """A valid place m for the split of e's edge u-w (shell point, else midpoint)."""
+    """A valid place m for the split of e's edge u-w: the shell point, else the
+    midpoint, else other points of its middle half (an exterior sliver behind a
+    boundary segment is thicker at some places than at others)."""
+    cdef int k
+    cdef double s
     _split_point(R, T, u, w, m)
     if _valid_split_near(T, e, m):
         return True
-    m[0] = 0.5 * (P(T, u)[0] + P(T, w)[0])
-    m[1] = 0.5 * (P(T, u)[1] + P(T, w)[1])
-    return _valid_split_near(T, e, m)
+    for k in range(7):
+        s = 0.5 + ((k + 1) // 2) * (1 if k % 2 else -1) * 0.08
+        m[0] = P(T, u)[0] + s * (P(T, w)[0] - P(T, u)[0])
+        m[1] = P(T, u)[1] + s * (P(T, w)[1] - P(T, u)[1])
+        if _valid_split_near(T, e, m):
+            return True
+    return False
 
 
 cdef bint _ghost_behind(Tri* T, int e) noexcept nogil:
