@@ -10,6 +10,8 @@ hold the ``nogil`` kernels:
 * cdt.pxi            constrained edges (Cline & Renka) and flood fills
 * sizing.pxi         the compiled size field (background grid)
 * front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
+* smoothing.pxi      smoothing after the front has closed
+* refine.pxi         the minimum-angle pass (Delaunay refinement)
 
 Every kernel routine returns a status code (0 or a count on success, a negative ERR_*
 from halfedge.pxd on failure); the methods here turn codes into exceptions.

@@ -717,8 +717,12 @@ cdef int _refine_triangle(Refine* R, Aft* A, Tri* T, int t) noexcept nogil:
         res = _encroached_by(R, T, X, where, NONE)
     if res < 0:
         return res
-    if R.enc_n > 0 and R.split_segments:
-        # (splits queue further pieces in R.sq; R.enc stays as it is meanwhile)
+    if R.enc_n > 0:
+        # (splits queue further pieces in R.sq; R.enc stays as it is meanwhile).
+        # Without segment splits, a point near a segment would only make way for
+        # the next one nearer still: the triangle is left as it is.
+        if not R.split_segments:
+            return ACT_DROPPED
         return _split_all(R, A, T, R.enc, R.enc_n)
     if R.max_triangles >= 0 and R.n_meshed + 2 > R.max_triangles:
         R.stop = STOP_MAX_TRIANGLES

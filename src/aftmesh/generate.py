@@ -164,7 +164,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     max_triangles : int, optional
         N_max: the mesh never has more triangles (formula (4) of the paper).
     min_area : float, optional
-        A_min: no new vertex whose triangle would be smaller (formula (5)).  By default
+        A_min: Basic_aft adds no vertex whose triangle would be smaller (formula (5);
+        the minimum-angle pass is bounded by its own caps instead).  By default
         1 % of the area of an equilateral triangle of the smallest size.
     order : {'shortest', 'longest', 'oldest'}
         Get_next_edge: shortest front edge first (default), longest first, or oldest
