@@ -503,61 +503,104 @@ cdef bint _choose_split(Refine* R, Tri* T, int e, int u, int w, double* m) noexc
     return False
 
 
-cdef bint _ghost_behind(Tri* T, int e) noexcept nogil:
-    """If the edge of e has a finite exterior triangle on one side with a hull edge,
-    flip that hull edge (both new triangles are ghosts; the hull may become reflex by
-    an ulp there, which no later step minds).  Returns whether it flipped."""
-    cdef int f = e, x, k
-    if T.tstate[e // 3] == T_MESHED:
-        f = T.twin[e]
-    if T.tstate[f // 3] != T_EXTERIOR or is_ghost(T, f // 3):
-        return False
-    for k in range(2):
-        x = nxt(f) if k == 0 else prv(f)
-        if is_ghost(T, T.twin[x] // 3) and not (T.eflag[x] & (E_SEGMENT | E_FIXED)):
-            flip(T, x)
-            return True
+cdef bint _inward_point(Refine* R, Tri* T, int f, int u, int w, double* m) noexcept nogil:
+    """A split point for boundary piece u-w strictly inside the meshed triangle of f
+    (its edge u-w): the shell point or midpoint, moved by a few ulps into the domain."""
+    cdef double* a = P(T, T.tv[f])
+    cdef double* b = P(T, T.tv[nxt(f)])
+    cdef double* c = P(T, T.tv[prv(f)])
+    cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h, x0, y0
+    cdef int k, j
+    for j in range(2):
+        if j == 0:
+            _split_point(R, T, u, w, m)
+        else:
+            m[0] = 0.5 * (a[0] + b[0])
+            m[1] = 0.5 * (a[1] + b[1])
+        x0 = m[0]
+        y0 = m[1]
+        h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
+        for k in range(9):
+            m[0] = x0 + k * h * nx      # (nx, ny) / L: the normal into f's triangle
+            m[1] = y0 + k * h * ny
+            if (orient2d(a, b, m) > 0 and orient2d(b, c, m) > 0
+                    and orient2d(c, a, m) > 0):
+                return True
     return False
+
+
+cdef int _split_inward(Tri* T, int f, int v) noexcept nogil:
+    """Put v (strictly inside the meshed triangle of f, an ulp or so from f's boundary
+    edge a-b) on the boundary: split that triangle at v, hand the sliver (a, b, v) to
+    the exterior and move the segment's flags from a-b to a-v and v-b.  The domain
+    loses the sliver (about an ulp times the edge's length).  Returns how many edges
+    facing v on the meshed side are on T.stack for the Lawson flips."""
+    cdef int a = T.tv[f], b = T.tv[nxt(f)], n, h, s, x, i, k = 0
+    cdef uint8_t g
+    n = split_triangle(T, f // 3, v)
+    if n < 0:
+        return n
+    h = find_edge(T, a, b)
+    if h < 0:
+        return ERR_INTERNAL
+    s = h // 3
+    T.tstate[s] = T_EXTERIOR
+    T.tregion[s] = T.tregion[T.twin[h] // 3]
+    g = T.eflag[h]
+    T.eflag[h] = 0
+    T.eflag[T.twin[h]] = 0
+    for i in range(2):
+        x = nxt(h) if i == 0 else prv(h)
+        T.eflag[x] = g
+        T.eflag[T.twin[x]] = g
+    for i in range(n):
+        if T.tstate[T.stack[i] // 3] == T_MESHED:
+            T.stack[k] = T.stack[i]
+            k += 1
+    return k
 
 
 cdef int _split_segment(Refine* R, Aft* A, Tri* T, int u, int w) noexcept nogil:
     """Split segment piece u-w (if it still is one).  Returns ACT_INSERTED, ACT_DROPPED
     or an error."""
     cdef int e = find_edge(T, u, w), v, n, add, res
-    cdef bint inside
+    cdef bint inward
     cdef double m[2]
     if e < 0 or not (T.eflag[e] & E_SEGMENT) or not R.split_segments:
         return ACT_DROPPED
     if _d2(P(T, u), P(T, w)) < 4.0 * R.tiny * R.tiny:
         return ACT_DROPPED
-    if not _choose_split(R, T, e, u, w, m):
-        # behind a boundary segment, a sliver of exterior triangle between it and the
-        # convex hull may leave no double to split at: make that side a ghost
-        if not _ghost_behind(T, e):
-            return ACT_DROPPED
-        e = find_edge(T, u, w)
-        if e < 0 or not _choose_split(R, T, e, u, w, m):
-            return ACT_DROPPED
     add = (T.tstate[e // 3] == T_MESHED) + (T.tstate[T.twin[e] // 3] == T_MESHED)
     if R.max_triangles >= 0 and R.n_meshed + add > R.max_triangles:
         R.stop = STOP_MAX_TRIANGLES
         return ACT_DROPPED
+    inward = False
+    if T.tstate[e // 3] != T_MESHED:
+        e = T.twin[e]               # e on the meshed side from here on
+    if not _choose_split(R, T, e, u, w, m):
+        # behind a boundary piece, slivers of exterior triangles between it and the
+        # convex hull (points an ulp inside the hull) may leave no double to split
+        # at: put the point an ulp or so into the domain instead
+        if add != 1 or not _inward_point(R, T, e, u, w, m):
+            return ACT_DROPPED
+        inward = True
     v = add_vertex(T, m[0], m[1])
     if v < 0 or _vend_reserve(R, T.nv):
         return ERR_NOMEM
     _chain_of_piece(R, u, w, &R.vend[2 * v], &R.vend[2 * v + 1])
-    inside = T.tstate[e // 3] == T_MESHED
-    n = split_edge(T, e, v)
-    if n < 0:
-        return n
-    # Flip only on the meshed side(s): split_edge stacked the edges facing v on e's
-    # side first, then on the twin's.  Flips among exterior triangles could make
-    # slivers out there that a later split an ulp off the line would invert.
-    if add == 1:
-        if not inside:
-            T.stack[0] = T.stack[2]
-            T.stack[1] = T.stack[3]
-        n = 2
+    if inward:
+        n = _split_inward(T, e, v)
+        if n < 0:
+            return n
+    else:
+        n = split_edge(T, e, v)
+        if n < 0:
+            return n
+        # Flip only on the meshed side(s): split_edge stacked the edges facing v on
+        # e's (meshed) side first.  Flips among exterior triangles could make slivers
+        # out there that a later split an ulp off the line would invert.
+        if add == 1:
+            n = 2
     res = lawson_after_insert(T, n)
     if res < 0:
         return res

@@ -118,17 +118,7 @@ def assert_guarantee(mesh, edges, bound, *, area=None) -> dict:
 
 
 # ------------------------------------------------------------------- the guarantee
-def _known_limit(case):
-    """The sliver's blunt end: the pass would split a piece of the long side whose
-    exterior side is a sliver of exterior triangle an ulp thick (the convex hull
-    passes within an ulp of the boundary) with no double in it where the split must
-    go; the piece stays whole and two triangles stay below the bound, reported as
-    unresolved (see refine.pxi)."""
-    return pytest.param(case, marks=pytest.mark.xfail(reason=_known_limit.__doc__, strict=True)) \
-        if case.name == "sliver" else case
-
-
-@pytest.mark.parametrize("case", [_known_limit(c) for c in dc.shapely_cases()], ids=repr)
+@pytest.mark.parametrize("case", dc.shapely_cases(), ids=repr)
 @pytest.mark.parametrize("bound", [28.0, 33.0])
 def test_shapely_cases_reach_the_bound(case, bound):
     mesh = aftmesh.generate(case.domain, case.size, min_angle=bound)
@@ -181,6 +171,21 @@ def test_coarse_size_needs_refinement():
     mesh = aftmesh.generate(case.domain, case.size, min_angle=28.0)
     info = assert_guarantee(mesh, case.edges, 28.0, area=case.area)
     assert info["inserted"] > 0 and info["segment_splits"] > 0
+
+
+@pytest.mark.parametrize("angle", [17.0, 33.3])
+@pytest.mark.parametrize("size", [1.0, 0.2])
+def test_slanted_boundary_on_the_hull_is_split(angle, size):
+    """A slanted channel whose long sides lie on the convex hull: their split points
+    an ulp inside the hull leave slivers of exterior triangles an ulp thick behind the
+    boundary, with no double in them where the next split must go; the pass then puts
+    the point an ulp into the domain (the sliver joins the exterior)."""
+    import shapely.affinity
+    poly = shapely.affinity.rotate(box(0, 0, 10, 0.05), angle, origin=(0, 0))
+    case = dc.shapely_case("slanted-channel", poly, size)
+    mesh = aftmesh.generate(poly, size, min_angle=33.0)
+    info = assert_guarantee(mesh, case.edges, 33.0, area=case.area)
+    assert info["segment_splits"] > 0
 
 
 # ---------------------------------------------------- termination on small angles
