@@ -142,6 +142,18 @@ cdef int _shortest_edge(Tri* T, int t) noexcept nogil:
     return best
 
 
+cdef bint _points_bad(Refine* R, const double* a, const double* b,
+                      const double* c) noexcept nogil:
+    """Whether the triangle a, b, c has an angle below the bound (at the corner
+    opposite its shortest side)."""
+    cdef double ab = _d2(a, b), bc = _d2(b, c), ca = _d2(c, a)
+    if ab <= bc and ab <= ca:
+        return _angle_below(c, a, b, R.c2_bad)
+    if bc <= ca:
+        return _angle_below(a, b, c, R.c2_bad)
+    return _angle_below(b, c, a, R.c2_bad)
+
+
 cdef inline bint _is_bad(Refine* R, Tri* T, int t) noexcept nogil:
     cdef int e = _shortest_edge(T, t)
     return _angle_below(P(T, T.tv[prv(e)]), P(T, T.tv[e]), P(T, T.tv[nxt(e)]), R.c2_bad)
@@ -688,6 +700,14 @@ cdef int _cavity_add(Refine* R, Tri* T, int t, int* n) noexcept nogil:
     return 0
 
 
+cdef inline bint _harmful(Refine* R, Tri* T, int h, const double* X) noexcept nogil:
+    """With segments kept whole, bad triangles near them cannot always be repaired, and
+    inserting there could make the mesh worse: X is then inserted only if every
+    triangle it makes (X and an edge h of the cavity's boundary) meets the bound, so
+    the worst angle never gets smaller."""
+    return not R.split_segments and _points_bad(R, P(T, T.tv[h]), P(T, T.tv[nxt(h)]), X)
+
+
 cdef int _encroached_by(Refine* R, Tri* T, const double* X, int t0, int t1) noexcept nogil:
     """Collect in R.enc the segments on the boundary of the cavity of X (the triangles
     whose circumcircles hold X, reached from t0 / t1 without crossing a constrained
@@ -707,7 +727,7 @@ cdef int _encroached_by(Refine* R, Tri* T, const double* X, int t0, int t1) noex
         for k in range(3):
             h = 3 * R.cav[i] + k
             if blocking(T, h):
-                if _encroaches(X, P(T, T.tv[h]), P(T, T.tv[nxt(h)])):
+                if _encroaches(X, P(T, T.tv[h]), P(T, T.tv[nxt(h)])) or _harmful(R, T, h, X):
                     if _grow_i32(&R.enc, &R.enc_cap, 2 * R.enc_n + 2):
                         return ERR_NOMEM
                     R.enc[2 * R.enc_n] = T.tv[h]
@@ -715,10 +735,14 @@ cdef int _encroached_by(Refine* R, Tri* T, const double* X, int t0, int t1) noex
                     R.enc_n += 1
                 continue
             nb = T.twin[h] // 3
-            if R.mark[nb] != R.epoch and incircle(
-                    P(T, T.tv[3 * nb]), P(T, T.tv[3 * nb + 1]), P(T, T.tv[3 * nb + 2]), X) > 0:
+            if R.mark[nb] == R.epoch:
+                continue
+            if incircle(P(T, T.tv[3 * nb]), P(T, T.tv[3 * nb + 1]), P(T, T.tv[3 * nb + 2]),
+                        X) > 0:
                 if _cavity_add(R, T, nb, &n):
                     return ERR_NOMEM
+            elif _harmful(R, T, h, X):
+                R.enc_n += 1            # (only counted: without splits X is dropped)
         i += 1
     return 0
 
