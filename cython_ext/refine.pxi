@@ -884,7 +884,7 @@ cdef int refine_mesh(Refine* R, Aft* A, Tri* T) noexcept nogil:
     R.max_triangles = A.max_triangles
     res = _scan_bad(R, T)
     if res <= 0:
-        return res if res < 0 else _final_scan(R, T)
+        return res                  # nothing is bad: the counts stay 0
     R.tiny = _tiny_length(T)
     R.max_insert = max(REFINE_CAP_MIN, REFINE_CAP_PER_TRIANGLE * R.n_meshed)
     res = _chain_init(R, T)
