@@ -89,8 +89,18 @@ cdef struct Refine:
 
 
 cdef void refine_free(Refine* R) noexcept nogil:
-    free(R.vend); free(R.tq); free(R.sq); free(R.cav); free(R.enc); free(R.mark)
-    R.vend = NULL; R.tq = NULL; R.sq = NULL; R.cav = NULL; R.enc = NULL; R.mark = NULL
+    free(R.vend)
+    free(R.tq)
+    free(R.sq)
+    free(R.cav)
+    free(R.enc)
+    free(R.mark)
+    R.vend = NULL
+    R.tq = NULL
+    R.sq = NULL
+    R.cav = NULL
+    R.enc = NULL
+    R.mark = NULL
 
 
 cdef int _grow_i32(int32_t** p, int* cap, int n) noexcept nogil:
@@ -234,8 +244,8 @@ cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
     while True:
         if T.tstate[e // 3] == T_MESHED:
             f = nxt(e)                  # the edge of v's triangle opposite v
-            if (T.eflag[f] & E_SEGMENT) and _encroaches(P(T, v), P(T, T.tv[f]),
-                                                          P(T, T.tv[nxt(f)])):
+            if (T.eflag[f] & E_SEGMENT) and _encroaches(
+                    P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt(f)])):
                 if _push_seg(R, T.tv[f], T.tv[nxt(f)]):
                     return ERR_NOMEM
             for k in range(2):
@@ -347,7 +357,7 @@ cdef bint _excepted(Refine* R, Tri* T, int e) noexcept nogil:
     sees p and q at an angle below the bound."""
     cdef int32_t cp[32]
     cdef int32_t cq[32]
-    cdef int p = T.tv[e], q = T.tv[nxt(e)], np_, nq, i, j, k, l, a
+    cdef int p = T.tv[e], q = T.tv[nxt(e)], np_, nq, i, j, k, m, a
     np_ = _chains_of(R, T, p, cp, 16)
     if np_ == 0:
         return False
@@ -360,9 +370,9 @@ cdef bint _excepted(Refine* R, Tri* T, int e) noexcept nogil:
                 a = cp[2 * i + k]
                 if a == p or a == q:
                     continue
-                for l in range(2):
-                    if cq[2 * j + l] == a and _angle_below(P(T, a), P(T, p), P(T, q),
-                                                          R.c2_small):
+                for m in range(2):
+                    if cq[2 * j + m] == a and _angle_below(
+                            P(T, a), P(T, p), P(T, q), R.c2_small):
                         return True
     return False
 
@@ -767,7 +777,7 @@ cdef int _refine_triangle(Refine* R, Aft* A, Tri* T, int t) noexcept nogil:
     _candidate(R, T, e, M, X)
     res = _walk(T, e, M, X, &where)
     if res == WALK_FAILED:
-            return ACT_DROPPED
+        return ACT_DROPPED
     if res == WALK_BLOCKED:
         if not (T.eflag[where] & E_SEGMENT):
             return ACT_DROPPED

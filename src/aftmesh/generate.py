@@ -208,8 +208,10 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         is proven to terminate up to about 26.5 degrees and does so in practice up to
         about 33.8, so values above 34 are refused; it is also capped (max_triangles
         wins over the bound; a last-resort cap of 8 insertions per triangle).  With
-        ``split_boundary=False`` it does not split input edges, and with ``greedy`` or
-        ``swaps=False`` it does not run.  ``info['min_angle']`` says what it did:
+        ``split_boundary=False`` it splits no input edge and inserts a point only where
+        all the triangles it makes meet the bound (the mesh never gets worse; the
+        bound may then stay out of reach); with ``greedy`` or ``swaps=False`` it does
+        not run.  ``info['min_angle']`` says what it did:
         ``bound``, ``reached`` (no triangle below the bound but the excepted ones),
         ``excepted_triangles``, ``unresolved_triangles``, ``inserted`` (of which
         ``segment_splits`` on segments), ``stopped_by`` (None, 'max_triangles' or
@@ -346,7 +348,8 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     refined = None
     if min_angle and swaps and not greedy:
         refined = kernel.refine(min_angle, len(dom.vertices), split_segments=split_boundary)
-        refined = dict(bound=min_angle, reached=refined["unresolved_triangles"] == 0, **refined)
+        refined = {"bound": min_angle, "reached": refined["unresolved_triangles"] == 0,
+                   **refined}
     t_aft = time.perf_counter()
     a = kernel.arrays()
     to_out = a["vertex_map"][built.merged]
