@@ -58,6 +58,12 @@ cdef double OFFCENTRE_FACTOR = 0.95
 # Concentric shells at apexes where two segments meet below this cosine (60 degrees,
 # the smallest input angle Ruppert's proof covers without them).
 cdef double SHELL_COS = 0.5
+# A split point may be moved this many ulps off its segment (beyond the rounding of
+# the point itself) to keep the triangles next to it counter-clockwise.
+cdef int SPLIT_NUDGE_ULPS = 1
+# Places in the middle half of a piece tried for its split when the first ones would
+# invert a sliver (slivers are thicker at some places than at others).
+cdef int SPLIT_TRIES = 32
 # Rotations around one vertex are capped by this many triangles (a broken structure
 # would otherwise loop).
 cdef int ROTATION_CAP = 1 << 20
@@ -239,19 +245,23 @@ cdef inline bint _encroaches(const double* x, const double* a, const double* b) 
 
 cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
     """After v was put on a segment: queue the segments around v that a vertex
-    encroaches (the two halves by their apexes, the far edges of v's star by v)."""
+    encroaches (the two halves by their apexes, the far edges of v's star by v), but
+    not a piece encroached by a vertex on another chain meeting it at a small angle:
+    near an apex a few ulps wide every split would encroach the other chain again."""
     cdef int e0 = T.vhe[v], e = e0, f, g, guard = 0, k
     while True:
         if T.tstate[e // 3] == T_MESHED:
             f = nxt(e)                  # the edge of v's triangle opposite v
             if (T.eflag[f] & E_SEGMENT) and _encroaches(
-                    P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt(f)])):
+                    P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt(f)])) and not _across_apex(
+                    R, T, v, T.tv[f], T.tv[nxt(f)]):
                 if _push_seg(R, T.tv[f], T.tv[nxt(f)]):
                     return ERR_NOMEM
             for k in range(2):
                 g = e if k == 0 else prv(e)     # the two edges of this triangle at v
                 if (T.eflag[g] & E_SEGMENT) and _encroaches(
-                        P(T, T.tv[prv(g)]), P(T, T.tv[g]), P(T, T.tv[nxt(g)])):
+                        P(T, T.tv[prv(g)]), P(T, T.tv[g]), P(T, T.tv[nxt(g)])) and not \
+                        _across_apex(R, T, T.tv[prv(g)], T.tv[g], T.tv[nxt(g)]):
                     if _push_seg(R, T.tv[g], T.tv[nxt(g)]):
                         return ERR_NOMEM
         e = T.twin[prv(e)]
@@ -377,24 +387,49 @@ cdef bint _excepted(Refine* R, Tri* T, int e) noexcept nogil:
     return False
 
 
+cdef bint _across_apex(Refine* R, Tri* T, int z, int x, int y) noexcept nogil:
+    """Whether vertex z lies on a chain other than that of segment piece x-y, the two
+    chains meeting at a common end below 60 degrees (seen from z and the piece)."""
+    cdef int32_t cz[32]
+    cdef int32_t a, b
+    cdef int n, i, k
+    cdef double mid[2]
+    n = _chains_of(R, T, z, cz, 16)
+    if n == 0:
+        return False
+    _chain_of_piece(R, x, y, &a, &b)
+    mid[0] = 0.5 * (P(T, x)[0] + P(T, y)[0])
+    mid[1] = 0.5 * (P(T, x)[1] + P(T, y)[1])
+    for i in range(n):
+        if (cz[2 * i] == a and cz[2 * i + 1] == b) or (cz[2 * i] == b and cz[2 * i + 1] == a):
+            continue
+        for k in range(2):
+            if (cz[2 * i + k] == a or cz[2 * i + k] == b) and cz[2 * i + k] != z and \
+                    _angle_below(P(T, cz[2 * i + k]), P(T, z), mid, SHELL_COS * SHELL_COS):
+                return True
+    return False
+
+
 # ---------------------------------------------------------------- segment splits
 
-cdef bint _small_apex(Tri* T, int a, const double* toward) noexcept nogil:
-    """Whether another segment leaves vertex a within 60 degrees of the direction
-    a->toward (the chain being split ends at a)."""
+cdef bint _small_apex(Refine* R, Tri* T, int a, const double* toward, int32_t ca,
+                      int32_t cb) noexcept nogil:
+    """Whether another segment than the chain (ca, cb) leaves vertex a (one of its
+    ends) within 60 degrees of the direction a->toward."""
     cdef int e0 = T.vhe[a], e = e0, guard = 0, w
     cdef double ux = toward[0] - P(T, a)[0], uy = toward[1] - P(T, a)[1], vx, vy, dot
     if e0 < 0:
         return False
     while True:
         w = T.tv[nxt(e)]
-        if (T.eflag[e] & E_SEGMENT) and w >= 0:
+        if (T.eflag[e] & E_SEGMENT) and w >= 0 and w != ca and w != cb and not (
+                (R.vend[2 * w] == ca and R.vend[2 * w + 1] == cb)
+                or (R.vend[2 * w] == cb and R.vend[2 * w + 1] == ca)):
             vx = P(T, w)[0] - P(T, a)[0]
             vy = P(T, w)[1] - P(T, a)[1]
             dot = ux * vx + uy * vy
-            # the same direction (the chain itself) has cross product ~0: skip it
             if dot > 0 and dot * dot > SHELL_COS * SHELL_COS * (ux * ux + uy * uy) * (
-                    vx * vx + vy * vy) and fabs(ux * vy - uy * vx) > 1e-9 * dot:
+                    vx * vx + vy * vy):
                 return True
         e = T.twin[prv(e)]
         guard += 1
@@ -437,40 +472,57 @@ cdef void _chain_of_piece(Refine* R, int u, int w, int32_t* a, int32_t* b) noexc
         b[0] = w
 
 
+cdef void _chain_point(Refine* R, Tri* T, int u, int w, double s, double* m) noexcept nogil:
+    """m = the point a fraction s of the way from u to w, computed on the line of the
+    chain's ends (its input segment), not from u and w: those are rounded points
+    already, and pieces of pieces would drift off the segment ulp by ulp."""
+    cdef int32_t a = NONE, b = NONE
+    cdef double* A
+    cdef double* B
+    cdef double dx, dy, L2, tu, tw, t
+    _chain_of_piece(R, u, w, &a, &b)
+    A = P(T, a)
+    B = P(T, b)
+    dx = B[0] - A[0]
+    dy = B[1] - A[1]
+    L2 = dx * dx + dy * dy
+    tu = ((P(T, u)[0] - A[0]) * dx + (P(T, u)[1] - A[1]) * dy) / L2
+    tw = ((P(T, w)[0] - A[0]) * dx + (P(T, w)[1] - A[1]) * dy) / L2
+    t = tu + s * (tw - tu)
+    if not (t > 0 and t < 1) or L2 <= 0:
+        m[0] = P(T, u)[0] + s * (P(T, w)[0] - P(T, u)[0])
+        m[1] = P(T, u)[1] + s * (P(T, w)[1] - P(T, u)[1])
+        return
+    m[0] = A[0] + t * dx
+    m[1] = A[1] + t * dy
+
+
 cdef void _split_point(Refine* R, Tri* T, int u, int w, double* m) noexcept nogil:
     """Where to split segment piece u-w: at the middle, or at a dyadic distance from an
     end of its chain where it meets another segment below 60 degrees."""
     cdef int32_t a = NONE, b = NONE
-    cdef int apex = NONE, near, far
+    cdef int apex = NONE
     cdef double mid[2]
-    cdef double du, dw, r, s
+    cdef double du, dw, r
     mid[0] = 0.5 * (P(T, u)[0] + P(T, w)[0])
     mid[1] = 0.5 * (P(T, u)[1] + P(T, w)[1])
-    m[0] = mid[0]
-    m[1] = mid[1]
+    _chain_point(R, T, u, w, 0.5, m)
     _chain_of_piece(R, u, w, &a, &b)
-    if _small_apex(T, a, mid):
+    if _small_apex(R, T, a, mid, a, b):
         apex = a
-    if _small_apex(T, b, mid) and (apex == NONE or _d2(P(T, b), mid) < _d2(P(T, a), mid)):
+    if _small_apex(R, T, b, mid, a, b) and (apex == NONE or _d2(P(T, b), mid) < _d2(P(T, a), mid)):
         apex = b
     if apex == NONE:
         return
     du = sqrt(_d2(P(T, apex), P(T, u)))
     dw = sqrt(_d2(P(T, apex), P(T, w)))
-    near = u
-    far = w
-    if du > dw:
-        near = w
-        far = u
-        r = du
-        du = dw
-        dw = r
-    if not dw > du:
+    if not dw != du:
         return
-    r = _dyadic_radius(du, dw)
-    s = (r - du) / (dw - du)
-    m[0] = P(T, near)[0] + s * (P(T, far)[0] - P(T, near)[0])
-    m[1] = P(T, near)[1] + s * (P(T, far)[1] - P(T, near)[1])
+    if du < dw:
+        r = _dyadic_radius(du, dw)
+    else:
+        r = _dyadic_radius(dw, du)
+    _chain_point(R, T, u, w, (r - du) / (dw - du), m)
 
 
 cdef bint _split_is_valid(Tri* T, int e, const double* m) noexcept nogil:
@@ -487,9 +539,8 @@ cdef bint _split_is_valid(Tri* T, int e, const double* m) noexcept nogil:
 
 
 cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
-    """Accept m, or move it by a few ulps to either side of e's edge: a point an ulp
-    off a segment of the domain's boundary can invert the sliver of exterior triangle
-    behind it."""
+    """Accept m, or move it by up to SPLIT_NUDGE_ULPS to either side of e's edge: a
+    point an ulp off a segment can invert a sliver of triangle next to it."""
     cdef double* a = P(T, T.tv[e])
     cdef double* b = P(T, T.tv[nxt(e)])
     cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h
@@ -498,7 +549,7 @@ cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
     if _split_is_valid(T, e, m):
         return True
     h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
-    for k in range(1, 9):
+    for k in range(1, 2 * SPLIT_NUDGE_ULPS + 1):
         # 1, -1, 2, -2, ... ulps along the normal
         m[0] = x0 + ((k + 1) // 2) * (1 if k % 2 else -1) * h * nx
         m[1] = y0 + ((k + 1) // 2) * (1 if k % 2 else -1) * h * ny
@@ -516,10 +567,9 @@ cdef bint _choose_split(Refine* R, Tri* T, int e, int u, int w, double* m) noexc
     _split_point(R, T, u, w, m)
     if _valid_split_near(T, e, m):
         return True
-    for k in range(7):
-        s = 0.5 + ((k + 1) // 2) * (1 if k % 2 else -1) * 0.08
-        m[0] = P(T, u)[0] + s * (P(T, w)[0] - P(T, u)[0])
-        m[1] = P(T, u)[1] + s * (P(T, w)[1] - P(T, u)[1])
+    for k in range(SPLIT_TRIES - 1):
+        s = 0.5 + ((k + 1) // 2) * (1 if k % 2 else -1) * (0.25 / SPLIT_TRIES)
+        _chain_point(R, T, u, w, s, m)
         if _valid_split_near(T, e, m):
             return True
     return False
@@ -527,22 +577,23 @@ cdef bint _choose_split(Refine* R, Tri* T, int e, int u, int w, double* m) noexc
 
 cdef bint _inward_point(Refine* R, Tri* T, int f, int u, int w, double* m) noexcept nogil:
     """A split point for boundary piece u-w strictly inside the meshed triangle of f
-    (its edge u-w): the shell point or midpoint, moved by a few ulps into the domain."""
+    (its edge u-w): the shell point, the midpoint or another point of the middle half,
+    moved by up to SPLIT_NUDGE_ULPS into the domain."""
     cdef double* a = P(T, T.tv[f])
     cdef double* b = P(T, T.tv[nxt(f)])
     cdef double* c = P(T, T.tv[prv(f)])
-    cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h, x0, y0
+    cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h, x0, y0, t
     cdef int k, j
-    for j in range(2):
+    for j in range(SPLIT_TRIES):
         if j == 0:
             _split_point(R, T, u, w, m)
         else:
-            m[0] = 0.5 * (a[0] + b[0])
-            m[1] = 0.5 * (a[1] + b[1])
+            t = 0.5 + (j // 2) * (1 if j % 2 else -1) * (0.25 / SPLIT_TRIES)
+            _chain_point(R, T, u, w, t, m)
         x0 = m[0]
         y0 = m[1]
         h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
-        for k in range(9):
+        for k in range(SPLIT_NUDGE_ULPS + 1):
             m[0] = x0 + k * h * nx      # (nx, ny) / L: the normal into f's triangle
             m[1] = y0 + k * h * ny
             if (orient2d(a, b, m) > 0 and orient2d(b, c, m) > 0

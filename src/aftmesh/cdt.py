@@ -10,6 +10,19 @@ from .pslg import build_cdt
 __all__ = ["cdt"]
 
 
+# Points the minimum-angle pass puts on a segment are off its line by a few ulps
+# (rounding, or moved into the domain past a sliver of exterior triangle): how far a
+# piece's end may be from the line, in units in the last place of the coordinates.
+PIECE_ULPS = 16
+
+
+def _within_ulps(pa, pb, pw) -> bool:
+    d = pb - pa
+    scale = max(float(np.abs(pa).max()), float(np.abs(pb).max()), float(np.abs(pw).max()))
+    cross = abs(float(d[0] * (pw[1] - pa[1]) - d[1] * (pw[0] - pa[0])))
+    return cross <= PIECE_ULPS * np.finfo(float).eps * scale * float(np.hypot(*d))
+
+
 def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.ndarray,
                     in_segments: np.ndarray, to_out: np.ndarray) -> np.ndarray:
     """For each output segment, the index of the input segment it is (a piece of).
@@ -57,16 +70,19 @@ def segment_markers(points: np.ndarray, out_segments: np.ndarray, in_points: np.
         cur, prev, guard = u, -1, 0
         while cur != v and guard <= len(points):
             guard += 1
-            step = -1
+            step = near = -1
             for w in adjacency.get(cur, ()):
                 if w == prev:
                     continue
                 pw = points[w]
-                if _kernel.py_orient2d(pa[0], pa[1], pb[0], pb[1], pw[0], pw[1]) != 0:
+                if not (np.dot(pw - points[cur], pb - pa) > 0 and np.dot(pb - pw, pb - pa) >= 0):
                     continue
-                if np.dot(pw - points[cur], pb - pa) > 0 and np.dot(pb - pw, pb - pa) >= 0:
+                if _kernel.py_orient2d(pa[0], pa[1], pb[0], pb[1], pw[0], pw[1]) == 0:
                     step = w
                     break
+                if near < 0 and _within_ulps(pa, pb, pw):
+                    near = w
+            step = step if step >= 0 else near
             if step < 0:
                 break
             markers[index[(cur, step)]] = j
