@@ -14,6 +14,8 @@ hold the ``nogil`` kernels:
 * ordering.pxi       Hilbert curve keys for the insertion order
 * front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
 * smoothing.pxi      smoothing after the front closes, with Delaunay flips
+* optimize.pxi       one smoothing move: the best candidate place of a vertex
+* refine.pxi         the minimum-angle pass (Delaunay refinement)
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -26,6 +28,8 @@ from halfedge cimport *
 from aft cimport Aft
 from cpython.ref cimport Py_XDECREF, PyObject
 from libc.stdlib cimport malloc, free
+
+import math
 
 import numpy as np
 
@@ -45,6 +49,7 @@ include "ordering.pxi"
 include "front.pxi"
 include "smoothing.pxi"
 include "optimize.pxi"
+include "refine.pxi"
 
 
 class KernelError(RuntimeError):
@@ -573,6 +578,37 @@ cdef class Triangulation:
         _reraise_pending(&self.A)
         _raise_for(&self.T, res)
         return res
+
+    def refine(self, double min_angle, int n_corners, bint split_segments=True):
+        """The minimum-angle pass (refine.pxi): Delaunay refinement of the meshed
+        triangles with an angle below `min_angle` degrees.  Vertices below `n_corners`
+        are input vertices (ends of input segments).  Respects max_triangles of
+        set_options.  Returns a dict of counts."""
+        cdef Refine R
+        cdef int res
+        cdef double c = math.cos(math.radians(min_angle))
+        memset(&R, 0, sizeof(Refine))
+        R.c2_bad = c * c * (1.0 - REFINE_ANGLE_MARGIN)
+        R.c2_small = c * c * (1.0 + REFINE_ANGLE_MARGIN)
+        R.offcentre = OFFCENTRE_FACTOR * 0.5 * math.sqrt((1.0 + c) / (1.0 - c))
+        R.split_segments = split_segments
+        R.n_corner = n_corners
+        try:
+            with nogil:
+                res = refine_mesh(&R, &self.A, &self.T)
+        finally:
+            refine_free(&R)
+        _reraise_pending(&self.A)
+        _raise_for(&self.T, res)
+        if DEBUG:
+            problems = self.validate()
+            if problems:
+                raise KernelError("after refine: " + "; ".join(problems[:5]))
+        return dict(inserted=R.inserted, segment_splits=R.splits, interior=R.interior,
+                    dropped=R.dropped, excepted_triangles=R.excepted,
+                    unresolved_triangles=R.unresolved, insertion_cap=R.max_insert,
+                    stopped_by={STOP_NONE: None, STOP_MAX_TRIANGLES: "max_triangles",
+                                STOP_CAP: "insertion_cap"}[R.stop])
 
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,

@@ -141,8 +141,10 @@ def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=No
     rows = assert_count_formula(mesh, EXPECTED_M.get(case.name) if case is not None else None)
     if case is not None and not isinstance(case.domain, dict):
         # no input vertex inside these domains: the interior vertices are exactly the
-        # ones Basic_aft created (Update_internal), each strictly inside
-        assert sum(r[2] for r in rows) == mesh.info["new_vertices"]
+        # ones Basic_aft created (Update_internal), each strictly inside, and the
+        # interior ones of the minimum-angle pass
+        refined = mesh.info["min_angle"]["interior"] if mesh.info["min_angle"] else 0
+        assert sum(r[2] for r in rows) == mesh.info["new_vertices"] + refined
     if delaunay:
         dc.assert_cdt(mesh)
     return mesh
@@ -334,7 +336,9 @@ def test_min_area_formula_5(case, factor):
     new vertex of the mesh is one of the R's that Mesh_size_constraint let through."""
     a_min = factor * (np.sqrt(3) / 4) * case.size ** 2
     rec = SizeConstraintRecorder()
-    mesh = aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0, strategy=rec)
+    # (min_angle=None: the refinement pass adds vertices of its own after Basic_aft)
+    mesh = aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0, strategy=rec,
+                            min_angle=None)
     assert_valid(mesh, case)
     assert rec.asked
     for x, y, area, refused in rec.asked:
@@ -347,7 +351,8 @@ def test_min_area_formula_5(case, factor):
     assert len(new_pts) == mesh.info["new_vertices"]
     assert new_pts <= allowed
     # same mesh as the compiled loop
-    assert same_mesh(mesh, aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0))
+    assert same_mesh(mesh, aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0,
+                                            min_angle=None))
 
 
 @pytest.mark.parametrize("case", [dc.square(), dc.comb(), dc.many_holes(3, "circle"),
@@ -360,13 +365,14 @@ def test_min_area_fewer_vertices(case):
     base = (np.sqrt(3) / 4) * case.size ** 2
     counts = []
     for factor in (0.0, 0.3, 3.0, 30.0):
-        mesh = aftmesh.generate(case.domain, case.size, min_area=factor * base)
+        mesh = aftmesh.generate(case.domain, case.size, min_area=factor * base,
+                                min_angle=None)
         assert_valid(mesh, case)
         counts.append(mesh.info["new_vertices"])
     assert counts[0] > 0 and counts[1] > 0, counts
     assert counts[2] <= counts[1] and counts[3] <= counts[2], counts
     # no candidate triangle is ever that large: formula (5) refuses every vertex
-    huge = aftmesh.generate(case.domain, case.size, min_area=1e6 * case.area)
+    huge = aftmesh.generate(case.domain, case.size, min_area=1e6 * case.area, min_angle=None)
     assert same_mesh(huge, aftmesh.generate(case.domain, case.size, greedy=True))
 
 
@@ -482,7 +488,7 @@ class HighestEdgeFirst(Strategy):
 def test_strategy_never_new_is_greedy(case):
     for split in (False, True):
         mesh = aftmesh.generate(case.domain, case.size, strategy=NeverNew(),
-                                split_boundary=split)
+                                split_boundary=split, min_angle=None)
         assert mesh.info["compiled_loop"] is False
         assert_valid(mesh, case, split_boundary=split)
         greedy = aftmesh.generate(case.domain, case.size, greedy=True, split_boundary=split)

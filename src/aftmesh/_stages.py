@@ -262,6 +262,16 @@ def smooth(kernel, boundary: Boundary, rounds: int) -> int:
     return kernel.smooth(len(boundary.vertices), rounds) if rounds else 0
 
 
+def refine(kernel, dom: Domain, opts: Options) -> dict | None:
+    """The minimum-angle pass after smoothing (none with greedy, without swaps, or with
+    min_angle off); what it did, for info["min_angle"].  With split_boundary=False it
+    splits no input edge and inserts only points whose triangles all meet the bound."""
+    if not opts.min_angle or opts.greedy or not opts.swaps:
+        return None
+    done = kernel.refine(opts.min_angle, len(dom.vertices), split_segments=opts.split_boundary)
+    return {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
+
+
 def assemble(
     kernel,
     boundary: Boundary,
@@ -271,6 +281,7 @@ def assemble(
     moves: int,
     timing: dict,
     edge_tags=None,
+    refined: dict | None = None,
 ) -> Mesh:
     """The Mesh: the kernel's compact arrays; for each segment its input edge
     (segment_sources), its marker (the user's ring / line / segment it lies on, or
@@ -292,6 +303,7 @@ def assemble(
         # inserting R, so F and G were inserted by retriangulation (Lemma 3.1 says 0)
         "forced_edges": counters["forced_edges"],
         "smoothing_moves": moves,
+        "min_angle": refined,
         "compiled_loop": opts.compiled,
         "size_field": field,
         "timing": timing,

@@ -15,7 +15,15 @@ from ._states import Order
 from .aft import Strategy
 from .errors import InvalidOptionError, InvalidSizeError
 
-__all__ = ["MAX_SMOOTH", "MAX_TRIANGLES", "ORDERS", "Options", "check_options"]
+__all__ = [
+    "DEFAULT_MIN_ANGLE",
+    "MAX_MIN_ANGLE",
+    "MAX_SMOOTH",
+    "MAX_TRIANGLES",
+    "ORDERS",
+    "Options",
+    "check_options",
+]
 
 # Get_next_edge's orders, as the kernel numbers them
 ORDERS = {"shortest": Order.SHORTEST, "longest": Order.LONGEST, "oldest": Order.OLDEST}
@@ -23,6 +31,12 @@ ORDERS = {"shortest": Order.SHORTEST, "longest": Order.LONGEST, "oldest": Order.
 MAX_SMOOTH = 1000
 # Kernel indices are int32: refuse a request for more triangles than that can number.
 MAX_TRIANGLES = 2**30
+# Default bound of the minimum-angle pass (degrees): Delaunay refinement is proven to
+# terminate up to about 26.5 degrees and does so in practice up to about 33.8; 28 leaves
+# a margin below that, and Basic_aft's meshes nearly meet it already (few points).
+DEFAULT_MIN_ANGLE = 28.0
+# Above this no Delaunay refinement is known to terminate in practice.
+MAX_MIN_ANGLE = 34.0
 
 
 @dataclass(frozen=True)
@@ -43,6 +57,7 @@ class Options:
     repair: bool = False
     tolerance: float = 0.0
     boundary_tags: Any = None
+    min_angle: float = 0.0  # 0: no minimum-angle pass
 
     @property
     def compiled(self) -> bool:
@@ -86,6 +101,20 @@ def _check_max_triangles(max_triangles) -> int | None:
     return min(int(max_triangles), MAX_TRIANGLES)
 
 
+def _min_angle(value) -> float:
+    """The bound of the minimum-angle pass in degrees, 0 for none."""
+    if value is None:
+        return 0.0
+    out = real("min_angle", value)
+    if out != 0 and not 0 < out <= MAX_MIN_ANGLE:
+        raise InvalidOptionError(
+            f"min_angle must be in (0, {MAX_MIN_ANGLE:g}] degrees (or 0 / None: no pass), "
+            f"got {value!r}: Delaunay refinement is known to terminate only up to about "
+            "33.8 degrees"
+        )
+    return out
+
+
 def check_options(
     *,
     order,
@@ -102,6 +131,7 @@ def check_options(
     repair=False,
     tolerance=0.0,
     boundary_tags=None,
+    min_angle=None,
 ) -> Options:
     """Validate generate's keyword options; return them as an :class:`Options`."""
     _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary, repair=repair))
@@ -130,6 +160,7 @@ def check_options(
     tolerance = real("tolerance", tolerance)
     if tolerance < 0:
         raise InvalidOptionError(f"tolerance must be >= 0, got {tolerance!r}")
+    bound = _min_angle(min_angle)
     return Options(
         order=order,
         max_triangles=max_triangles,
@@ -145,4 +176,5 @@ def check_options(
         repair=bool(repair),
         tolerance=tolerance,
         boundary_tags=boundary_tags,
+        min_angle=bound,
     )
