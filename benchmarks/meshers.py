@@ -49,6 +49,10 @@ class Runner:
 # name -> (label for the tables, short description)
 MESHERS = {
     "aft": ("aftmesh", "aftmesh.generate(..., split_boundary=False)"),
+    "aft-split": (
+        "aftmesh (segments may split)",
+        "aftmesh.generate(...): like Triangle pq30a, may split input segments",
+    ),
     "aft-greedy": ("aftmesh greedy", "aftmesh.generate(..., greedy=True): no new points"),
     "tri-pq30": ("Triangle pq30a", "triangle 'pq30a<A>', A = sqrt(3)/4 h^2 (may split segments)"),
     "tri-pq30Y": ("Triangle pq30aY", "triangle 'pq30a<A>Y': no Steiner points on segments"),
@@ -84,14 +88,14 @@ def triangle_area_switch(area: float) -> str:
 # ----------------------------------------------------------------------- aftmesh
 
 
-def _aft(case: Case, greedy: bool) -> Runner:
+def _aft(case: Case, greedy: bool, split: bool = False) -> Runner:
     import aftmesh
 
     dom = case.as_triangle_dict()
     size = case.size_arg
 
     def run():
-        return aftmesh.generate(dom, size, split_boundary=False, greedy=greedy)
+        return aftmesh.generate(dom, size, split_boundary=split, greedy=greedy)
 
     def result(m):
         return MeshOut(np.asarray(m.points), np.asarray(m.triangles), len(m.segments))
@@ -285,6 +289,8 @@ def _gmsh(case: Case, algorithm: int) -> Runner:
 def prepare(name: str, case: Case) -> Runner:
     if name == "aft":
         return _aft(case, greedy=False)
+    if name == "aft-split":
+        return _aft(case, greedy=False, split=True)
     if name == "aft-greedy":
         return _aft(case, greedy=True)
     if name == "tri-pq30":

@@ -114,7 +114,7 @@ def build_realworld(name: str) -> Case:
 
 # ----------------------------------------------------------------------- the table
 
-GROUP_MESHERS = ["aft", "gmsh-frontal", "tri-pq30"]
+GROUP_MESHERS = ["aft", "aft-split", "gmsh-frontal", "tri-pq30"]
 _SHORT = {"aft": "aft", "gmsh-frontal": "Gmsh6", "tri-pq30": "Tri"}
 
 

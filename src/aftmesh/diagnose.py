@@ -24,7 +24,9 @@ final mesh whose radius ratio is below a threshold with the first class that app
     none of these.
 
 It needs the same vertex numbering in both meshes: smoothing moves vertices but
-neither adds nor removes any, and the Python loop gives the compiled loop's mesh.
+neither adds nor removes any, and the Python loop gives the compiled loop's mesh.  So it
+diagnoses Basic_aft and smoothing, before the minimum-angle pass (``min_angle=None``
+unless given: the pass adds vertices of its own).
 """
 from __future__ import annotations
 
@@ -157,6 +159,7 @@ def diagnose(domain, size=None, *, threshold: float = 0.9, **options) -> Diagnos
     True
     """
     rec = _Recorder()
+    options = {"min_angle": None, **options}
     plain = generate(domain, size, **{**options, "smooth": 0, "strategy": rec})
     mesh = generate(domain, size, **options)
     if len(plain.points) != len(mesh.points):
