@@ -30,9 +30,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from ._typing import DomainArg, SizeArg
 from .aft import Strategy
 from .generate import generate
 from .mesh import Mesh, triangle_quality
@@ -144,7 +146,9 @@ def _collision(mesh: Mesh, rec: _Recorder, index: dict) -> np.ndarray:
     return by_bridge | opposing
 
 
-def diagnose(domain, size=None, *, threshold: float = 0.9, **options) -> Diagnosis:
+def diagnose(
+    domain: DomainArg, size: SizeArg = None, *, threshold: float = 0.9, **options: Any
+) -> Diagnosis:
     """Mesh ``domain`` with ``generate(domain, size, **options)`` and label its
     triangles with radius ratio below ``threshold`` by cause (see the module's
     docstring for the classes and the heuristics).
