@@ -140,6 +140,7 @@ def _main(argv) -> int:
         return 0
     if args.parallel:
         from . import parallel
+
         return parallel.main(args.quick, args.out)
     from . import plots, report, runner
 
@@ -147,6 +148,7 @@ def _main(argv) -> int:
     out.mkdir(parents=True, exist_ok=True)
     if args.realworld:
         from .realworld import run_group
+
         return run_group(args, out)
     store = out / "results.json"
     results = {}

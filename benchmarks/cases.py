@@ -329,7 +329,8 @@ def build_case(name: str) -> Case:
     if name == "inclusion":
         return inclusion()
     if kind == "rw" and arg:
-        from .realworld import build_realworld     # the real-world group (--realworld)
+        from .realworld import build_realworld  # the real-world group (--realworld)
+
         return build_realworld(name)
     raise KeyError(f"unknown case {name!r}; known: {', '.join(ALL_CASES)}")
 

@@ -4,6 +4,7 @@ Each builder returns a :class:`Built`: a shapely geometry, the target size and, 
 graded cases, the size as a numpy callable plus the same formula for Gmsh's MathEval
 field.  Randomness is seeded, so every run meshes the same domains.
 """
+
 from __future__ import annotations
 
 import math
@@ -16,17 +17,17 @@ from shapely.geometry import LineString, MultiPolygon, Point, Polygon, box
 
 __all__ = ["BUILT", "Built"]
 
-SEED = 20261127          # one seed for every random domain: runs compare like with like
-CIRCLE_QUAD_SEGS = 16    # shapely buffer resolution (points per quarter circle)
+SEED = 20261127  # one seed for every random domain: runs compare like with like
+CIRCLE_QUAD_SEGS = 16  # shapely buffer resolution (points per quarter circle)
 
 
 @dataclass
 class Built:
-    geometry: object                    # shapely Polygon / MultiPolygon
-    h: float                            # uniform size, or the smallest graded size
+    geometry: object  # shapely Polygon / MultiPolygon
+    h: float  # uniform size, or the smallest graded size
     description: str
-    size: Callable | None = None        # graded size f(x, y) -> array
-    gmsh_size_expr: str | None = None   # the same size for Gmsh's MathEval field
+    size: Callable | None = None  # graded size f(x, y) -> array
+    gmsh_size_expr: str | None = None  # the same size for Gmsh's MathEval field
 
 
 def _diag(geom) -> float:
@@ -48,7 +49,8 @@ def _scatter(rng, region, radii, gap, make):
     x0, y0, x1, y1 = region.bounds
     for r in sorted(radii, reverse=True):
         for _ in range(200):
-            cx, cy = rng.uniform(x0 + r + gap, x1 - r - gap), rng.uniform(y0 + r + gap, y1 - r - gap)
+            cx = rng.uniform(x0 + r + gap, x1 - r - gap)
+            cy = rng.uniform(y0 + r + gap, y1 - r - gap)
             shape = make(rng, cx, cy, r)
             if all(shape.distance(p) > gap for p in placed):
                 placed.append(shape)
@@ -58,11 +60,12 @@ def _scatter(rng, region, radii, gap, make):
 
 # ----------------------------------------------------------------------- builders
 
+
 def coast() -> Built:
     """A fractal coastline: midpoint displacement of a rough square, 7 levels."""
     rng = np.random.default_rng(SEED)
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    for level in range(7):
+    for _level in range(7):
         nxt = np.roll(pts, -1, axis=0)
         mid = 0.5 * (pts + nxt)
         d = nxt - pts
@@ -81,8 +84,9 @@ def islands() -> Built:
     """A bay with 40 small irregular islands (holes)."""
     rng = np.random.default_rng(SEED + 1)
     sea = box(0.0, 0.0, 2.0, 1.0)
-    isles = _scatter(rng, sea, rng.uniform(0.015, 0.05, 40), 0.02,
-                     lambda r_, x, y, r: _blob(r_, x, y, r))
+    isles = _scatter(
+        rng, sea, rng.uniform(0.015, 0.05, 40), 0.02, lambda r_, x, y, r: _blob(r_, x, y, r)
+    )
     geom = sea.difference(shapely.union_all(isles))
     return Built(geom, _diag(geom) / 80, f"sea 2 x 1 with {len(isles)} small islands as holes")
 
@@ -90,15 +94,21 @@ def islands() -> Built:
 def archipelago() -> Built:
     """A MultiPolygon of 25 disjoint islands, one with a lake holding an islet."""
     rng = np.random.default_rng(SEED + 2)
-    isles = _scatter(rng, box(0.0, 0.0, 3.0, 2.0), rng.uniform(0.05, 0.3, 25), 0.03,
-                     lambda r_, x, y, r: _blob(r_, x, y, r, n=14, wobble=0.25))
+    isles = _scatter(
+        rng,
+        box(0.0, 0.0, 3.0, 2.0),
+        rng.uniform(0.05, 0.3, 25),
+        0.03,
+        lambda r_, x, y, r: _blob(r_, x, y, r, n=14, wobble=0.25),
+    )
     big = max(isles, key=lambda g: g.area)
     c = big.centroid
     lake = Point(c.x, c.y).buffer(0.3 * math.sqrt(big.area / math.pi), CIRCLE_QUAD_SEGS)
     islet = Point(c.x, c.y).buffer(0.1 * math.sqrt(big.area / math.pi), CIRCLE_QUAD_SEGS)
     isles[isles.index(big)] = big.difference(lake)
     geom = MultiPolygon([*isles, islet])
-    return Built(geom, _diag(geom) / 100, f"{len(isles) + 1} disjoint islands, a lake with an islet")
+    what = f"{len(isles) + 1} disjoint islands, a lake with an islet"
+    return Built(geom, _diag(geom) / 100, what)
 
 
 def river() -> Built:
@@ -106,9 +116,12 @@ def river() -> Built:
     x = np.linspace(0.0, 4.0, 200)
     main = LineString(np.column_stack([x, 0.6 + 0.3 * np.sin(2.2 * x)]))
     xt = np.linspace(1.3, 2.2, 60)
-    trib = LineString(np.column_stack([xt, 0.6 + 0.3 * np.sin(2.2 * 1.3) + 0.9 * (xt - 1.3) ** 0.8]))
-    water = shapely.union(main.buffer(0.03, CIRCLE_QUAD_SEGS, cap_style="flat"),
-                          trib.buffer(0.02, CIRCLE_QUAD_SEGS, cap_style="flat"))
+    yt = 0.6 + 0.3 * np.sin(2.2 * 1.3) + 0.9 * (xt - 1.3) ** 0.8
+    trib = LineString(np.column_stack([xt, yt]))
+    water = shapely.union(
+        main.buffer(0.03, CIRCLE_QUAD_SEGS, cap_style="flat"),
+        trib.buffer(0.02, CIRCLE_QUAD_SEGS, cap_style="flat"),
+    )
     geom = water.intersection(box(0.0, 0.0, 4.0, 1.2))
     return Built(geom, 0.012, "meandering river 0.06 wide with a tributary 0.04 wide")
 
@@ -118,15 +131,22 @@ def _naca4(m, p, t, n=120, chord=1.0, x0=0.0, y0=0.0, angle=0.0) -> Polygon:
     nose up positive) about its leading edge and moved to (x0, y0)."""
     beta = np.linspace(0.0, math.pi, n)
     x = 0.5 * (1.0 - np.cos(beta))
-    yt = 5 * t * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x ** 2 + 0.2843 * x ** 3
-                  - 0.1036 * x ** 4)
+    yt = 5 * t * (0.2969 * np.sqrt(x) - 0.1260 * x - 0.3516 * x**2 + 0.2843 * x**3 - 0.1036 * x**4)
     if m > 0:
-        yc = np.where(x < p, m / p ** 2 * (2 * p * x - x ** 2),
-                      m / (1 - p) ** 2 * (1 - 2 * p + 2 * p * x - x ** 2))
+        yc = np.where(
+            x < p, m / p**2 * (2 * p * x - x**2), m / (1 - p) ** 2 * (1 - 2 * p + 2 * p * x - x**2)
+        )
     else:
         yc = np.zeros_like(x)
-    ring = np.concatenate([np.column_stack([x[::-1], yc[::-1] + yt[::-1]]),
-                           np.column_stack([x[1:-1], yc[1:-1] - yt[1:-1]])]) * chord
+    ring = (
+        np.concatenate(
+            [
+                np.column_stack([x[::-1], yc[::-1] + yt[::-1]]),
+                np.column_stack([x[1:-1], yc[1:-1] - yt[1:-1]]),
+            ]
+        )
+        * chord
+    )
     a = -math.radians(angle)
     rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
     return Polygon(ring @ rot.T + [x0, y0])
@@ -139,7 +159,7 @@ def airfoil() -> Built:
     return Built(geom, 1.0 / 60, "NACA 2412 at 4 deg in a 4 x 2 channel, h = chord / 60")
 
 
-HL_H0, HL_SLOPE, HL_HMAX = 0.004, 0.12, 0.15   # high-lift size: fine at the elements
+HL_H0, HL_SLOPE, HL_HMAX = 0.004, 0.12, 0.15  # high-lift size: fine at the elements
 
 
 def highlift() -> Built:
@@ -155,10 +175,16 @@ def highlift() -> Built:
         y = np.asarray(y, dtype=float)
         dx = np.maximum(np.maximum(-0.2 - x, x - 1.2), 0.0)
         return np.minimum(HL_H0 + HL_SLOPE * np.sqrt(dx * dx + y * y), HL_HMAX)
+
     dxe = "Max(Max(-0.2 - x, x - 1.2), 0)"
     expr = f"Min({HL_H0} + {HL_SLOPE} * Sqrt({dxe} * {dxe} + y * y), {HL_HMAX})"
-    return Built(geom, HL_H0, "3-element high-lift airfoil (slat, main, flap), graded size",
-                 size=size, gmsh_size_expr=expr)
+    return Built(
+        geom,
+        HL_H0,
+        "3-element high-lift airfoil (slat, main, flap), graded size",
+        size=size,
+        gmsh_size_expr=expr,
+    )
 
 
 def gear() -> Built:
@@ -172,10 +198,11 @@ def gear() -> Built:
             pts.append((r * math.cos(a), r * math.sin(a)))
     hub = Point(0, 0).buffer(0.3, CIRCLE_QUAD_SEGS).union(box(-0.05, 0.25, 0.05, 0.36))
     geom = Polygon(pts).difference(hub)
-    for k in range(6):           # lightening holes
+    for k in range(6):  # lightening holes
         a = 2 * math.pi * k / 6
-        geom = geom.difference(Point(0.6 * math.cos(a), 0.6 * math.sin(a))
-                               .buffer(0.12, CIRCLE_QUAD_SEGS))
+        geom = geom.difference(
+            Point(0.6 * math.cos(a), 0.6 * math.sin(a)).buffer(0.12, CIRCLE_QUAD_SEGS)
+        )
     return Built(geom, _diag(geom) / 100, "24-tooth gear, hub with keyway, 6 lightening holes")
 
 
@@ -201,8 +228,9 @@ def mixed_holes() -> Built:
     rng = np.random.default_rng(SEED + 4)
     plate = box(0.0, 0.0, 2.0, 1.0)
     radii = np.exp(rng.uniform(math.log(0.006), math.log(0.1), 120))
-    holes = _scatter(rng, plate, radii, 0.01,
-                     lambda r_, x, y, r: Point(x, y).buffer(r, CIRCLE_QUAD_SEGS))
+    holes = _scatter(
+        rng, plate, radii, 0.01, lambda r_, x, y, r: Point(x, y).buffer(r, CIRCLE_QUAD_SEGS)
+    )
     geom = plate.difference(shapely.union_all(holes))
     return Built(geom, _diag(geom) / 100, f"plate 2 x 1 with {len(holes)} holes of mixed sizes")
 
@@ -213,7 +241,7 @@ def thin_layer() -> Built:
     return Built(geom, 0.012, "annular shell 0.02 thick, h = 0.012")
 
 
-GP_H0, GP_SLOPE, GP_HMAX = 0.002, 0.15, 0.04   # graded from a point
+GP_H0, GP_SLOPE, GP_HMAX = 0.002, 0.15, 0.04  # graded from a point
 
 
 def graded_point() -> Built:
@@ -223,12 +251,18 @@ def graded_point() -> Built:
     def size(x, y):
         r = np.hypot(np.asarray(x, dtype=float), np.asarray(y, dtype=float))
         return np.minimum(GP_H0 + GP_SLOPE * r, GP_HMAX)
+
     expr = f"Min({GP_H0} + {GP_SLOPE} * Sqrt(x * x + y * y), {GP_HMAX})"
-    return Built(geom, GP_H0, "unit square with a hole, size graded from the corner (0, 0)",
-                 size=size, gmsh_size_expr=expr)
+    return Built(
+        geom,
+        GP_H0,
+        "unit square with a hole, size graded from the corner (0, 0)",
+        size=size,
+        gmsh_size_expr=expr,
+    )
 
 
-GC_H0, GC_SLOPE, GC_HMAX = 0.004, 0.3, 0.08    # graded from a curve
+GC_H0, GC_SLOPE, GC_HMAX = 0.004, 0.3, 0.08  # graded from a curve
 
 
 def graded_curve() -> Built:
@@ -239,13 +273,28 @@ def graded_curve() -> Built:
         x = np.asarray(x, dtype=float)
         d = np.abs(np.asarray(y, dtype=float) - 0.5 - 0.15 * np.sin(2 * math.pi * x))
         return np.minimum(GC_H0 + GC_SLOPE * d, GC_HMAX)
-    expr = (f"Min({GC_H0} + {GC_SLOPE} * Abs(y - 0.5 - 0.15 * Sin(2 * {math.pi!r} * x)), "
-            f"{GC_HMAX})")
-    return Built(geom, GC_H0, "2 x 1 rectangle, size graded from a sine curve",
-                 size=size, gmsh_size_expr=expr)
+
+    expr = f"Min({GC_H0} + {GC_SLOPE} * Abs(y - 0.5 - 0.15 * Sin(2 * {math.pi!r} * x)), {GC_HMAX})"
+    return Built(
+        geom,
+        GC_H0,
+        "2 x 1 rectangle, size graded from a sine curve",
+        size=size,
+        gmsh_size_expr=expr,
+    )
 
 
-BUILT = {"coast": coast, "islands": islands, "archipelago": archipelago, "river": river,
-         "airfoil": airfoil, "highlift": highlift, "gear": gear, "city": city,
-         "mixed-holes": mixed_holes, "thin-layer": thin_layer,
-         "graded-point": graded_point, "graded-curve": graded_curve}
+BUILT = {
+    "coast": coast,
+    "islands": islands,
+    "archipelago": archipelago,
+    "river": river,
+    "airfoil": airfoil,
+    "highlift": highlift,
+    "gear": gear,
+    "city": city,
+    "mixed-holes": mixed_holes,
+    "thin-layer": thin_layer,
+    "graded-point": graded_point,
+    "graded-curve": graded_curve,
+}

@@ -6,6 +6,7 @@ boundary, size transition, front collision, other), prints the counts per class 
 draws the bad triangles coloured by class.  CASE is any benchmark case name (see
 ``python -m benchmarks --list``), including the real-world group's ``rw-*``.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -14,20 +15,28 @@ from pathlib import Path
 
 from .cases import build_case
 
-COLOURS = {"smoothing": "tab:purple", "boundary": "tab:blue", "size": "tab:orange",
-           "collision": "tab:red", "other": "tab:gray"}
+COLOURS = {
+    "smoothing": "tab:purple",
+    "boundary": "tab:blue",
+    "size": "tab:orange",
+    "collision": "tab:red",
+    "other": "tab:gray",
+}
 OUT = Path(__file__).resolve().parent / "out"
 
 
 def diagnose_case(name: str, threshold: float):
     from aftmesh.diagnose import diagnose
+
     case = build_case(name)
-    return diagnose(case.as_triangle_dict(), case.size_arg, threshold=threshold,
-                    split_boundary=False)
+    return diagnose(
+        case.as_triangle_dict(), case.size_arg, threshold=threshold, split_boundary=False
+    )
 
 
 def draw(diag, title: str, path: Path) -> None:
     import matplotlib
+
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.collections import PolyCollection
@@ -42,8 +51,11 @@ def draw(diag, title: str, path: Path) -> None:
     for c, colour in COLOURS.items():
         sel = diag.bad[diag.labels == c]
         if len(sel):
-            ax.add_collection(PolyCollection(m.points[m.triangles[sel]], facecolor=colour,
-                                             edgecolor=colour, lw=0.3))
+            ax.add_collection(
+                PolyCollection(
+                    m.points[m.triangles[sel]], facecolor=colour, edgecolor=colour, lw=0.3
+                )
+            )
             handles.append(Patch(color=colour, label=f"{c} ({len(sel)})"))
     ax.set_aspect("equal")
     ax.set_title(title)
@@ -54,12 +66,20 @@ def draw(diag, title: str, path: Path) -> None:
 
 
 def main(argv=None) -> int:
-    p = argparse.ArgumentParser(prog="python -m benchmarks.quality", description=__doc__.split("\n\n")[1])
+    doc = (__doc__ or "").split("\n\n")
+    p = argparse.ArgumentParser(prog="python -m benchmarks.quality", description=doc[1])
     p.add_argument("cases", nargs="+", metavar="CASE")
-    p.add_argument("--threshold", type=float, default=0.9, help="radius ratio below which a "
-                   "triangle is bad (default 0.9)")
-    p.add_argument("--png", type=Path, help="picture path (one case), default "
-                   "benchmarks/out/quality_<case>.png")
+    p.add_argument(
+        "--threshold",
+        type=float,
+        default=0.9,
+        help="radius ratio below which a triangle is bad (default 0.9)",
+    )
+    p.add_argument(
+        "--png",
+        type=Path,
+        help="picture path (one case), default benchmarks/out/quality_<case>.png",
+    )
     args = p.parse_args(sys.argv[1:] if argv is None else argv)
     OUT.mkdir(parents=True, exist_ok=True)
     total: dict[str, int] = {}

@@ -11,6 +11,7 @@ boundary is noded, each edge cut into pieces no longer than the size (or, for a 
 size, about size() long), vertices shared by touching rings merged, and a hole point
 put in every bounded face of the segment graph that the geometry does not cover.
 """
+
 from __future__ import annotations
 
 import json
@@ -27,9 +28,9 @@ from .domains import BUILT
 __all__ = ["REALWORLD_CASES", "build_realworld", "geometry_to_case", "summary_table"]
 
 DATA = Path(__file__).resolve().parent / "data" / "realworld"
-DIVISIONS = 60           # h = bbox diagonal / 60: 1e3-1e5 triangles on these outlines
+DIVISIONS = 60  # h = bbox diagonal / 60: 1e3-1e5 triangles on these outlines
 PREFIX = "rw-"
-GRADED_SAMPLES = 64      # samples per edge when integrating 1/size along it
+GRADED_SAMPLES = 64  # samples per edge when integrating 1/size along it
 
 OUTLINES = sorted(p.stem for p in DATA.glob("*.json"))
 REALWORLD_CASES = [PREFIX + n for n in OUTLINES] + [PREFIX + n for n in BUILT]
@@ -88,12 +89,14 @@ def geometry_to_pslg(geom, h: float, size=None):
     return V, S, np.array(holes, dtype=np.float64).reshape(-1, 2)
 
 
-def geometry_to_case(name: str, description: str, geom, h: float, size=None,
-                     gmsh_size_expr=None) -> Case:
+def geometry_to_case(
+    name: str, description: str, geom, h: float, size=None, gmsh_size_expr=None
+) -> Case:
     V, S, holes = geometry_to_pslg(geom, h, size)
     notes = [f"{geom.geom_type}, {len(V)} boundary vertices"]
-    return Case(name, description, V, S, holes, h, size=size, gmsh_size_expr=gmsh_size_expr,
-                notes=notes)
+    return Case(
+        name, description, V, S, holes, h, size=size, gmsh_size_expr=gmsh_size_expr, notes=notes
+    )
 
 
 def build_realworld(name: str) -> Case:
@@ -106,8 +109,10 @@ def build_realworld(name: str) -> Case:
         geom, meta = load_outline(base)
         x0, y0, x1, y1 = geom.bounds
         h = math.hypot(x1 - x0, y1 - y0) / DIVISIONS
-        desc = (f"{meta['source_repo']}:{meta['source_path']} ({meta['licence']}), "
-                f"h = bbox diagonal / {DIVISIONS} = {h:.4g}")
+        desc = (
+            f"{meta['source_repo']}:{meta['source_path']} ({meta['licence']}), "
+            f"h = bbox diagonal / {DIVISIONS} = {h:.4g}"
+        )
         return geometry_to_case(name, desc, geom, h)
     raise KeyError(f"unknown real-world case {name!r}; known: {', '.join(REALWORLD_CASES)}")
 
@@ -122,8 +127,13 @@ def _cells(r: dict) -> list[str] | None:
     s = r.get("stats")
     if not s or "median" not in r:
         return None
-    return [f"{s['rr_mean']:.4f}", f"{100 * s['rr_above_0.9']:.1f}", f"{s['min_angle']:.1f}",
-            str(s["triangles"]), f"{r['median']:.3g}"]
+    return [
+        f"{s['rr_mean']:.4f}",
+        f"{100 * s['rr_above_0.9']:.1f}",
+        f"{s['min_angle']:.1f}",
+        str(s["triangles"]),
+        f"{r['median']:.3g}",
+    ]
 
 
 def summary_table(sec: dict) -> str:
@@ -133,8 +143,10 @@ def summary_table(sec: dict) -> str:
     by = {(r["case"], r["mesher"]): r for r in sec["rows"]}
     meshers = [m for m in GROUP_MESHERS if any(k[1] == m for k in by)]
     lab = " / ".join(_SHORT[m] for m in meshers)
-    hdr = (f"| case | RR mean {lab} | % RR > 0.9 {lab} | min angle {lab} | triangles {lab} | "
-           f"time {lab} |")
+    hdr = (
+        f"| case | RR mean {lab} | % RR > 0.9 {lab} | min angle {lab} | triangles {lab} | "
+        f"time {lab} |"
+    )
     out = [hdr, "|" + "---|" * 6]
     common, missing = [], []
     for cname in dict.fromkeys(r["case"] for r in sec["rows"]):
@@ -148,13 +160,23 @@ def summary_table(sec: dict) -> str:
     avg = []
     for m in meshers:
         st = [by[(c, m)]["stats"] for c in common]
-        avg.append([np.mean([s[k] for s in st]) if st else np.nan
-                    for k in ("rr_mean", "rr_above_0.9", "min_angle", "triangles")])
-    out.append(f"| **average ({len(common)} cases)** | "
-               + " / ".join(f"{a[0]:.4f}" for a in avg) + " | "
-               + " / ".join(f"{100 * a[1]:.1f}" for a in avg) + " | "
-               + " / ".join(f"{a[2]:.1f}" for a in avg) + " | "
-               + " / ".join(f"{a[3]:.0f}" for a in avg) + " | - |")
+        avg.append(
+            [
+                np.mean([s[k] for s in st]) if st else np.nan
+                for k in ("rr_mean", "rr_above_0.9", "min_angle", "triangles")
+            ]
+        )
+    out.append(
+        f"| **average ({len(common)} cases)** | "
+        + " / ".join(f"{a[0]:.4f}" for a in avg)
+        + " | "
+        + " / ".join(f"{100 * a[1]:.1f}" for a in avg)
+        + " | "
+        + " / ".join(f"{a[2]:.1f}" for a in avg)
+        + " | "
+        + " / ".join(f"{a[3]:.0f}" for a in avg)
+        + " | - |"
+    )
     if missing:
         out.append("")
         out.append(f"Left out of the averages (a mesher failed): {', '.join(missing)}.")
@@ -169,20 +191,24 @@ def run_group(args, out: Path) -> int:
     import fnmatch
 
     from . import runner
+
     names = REALWORLD_CASES
     if args.cases:
         names = [c for c in names if any(fnmatch.fnmatch(c, p) for p in args.cases)]
     meshers = args.meshers or GROUP_MESHERS
     limit = args.gmsh_limit if args.gmsh_limit is not None else 3e5
     print(f"real-world group: {len(names)} cases x {len(meshers)} meshers")
-    sec = runner.run_mesh_suite(names, meshers, quick=True, repeat=min(args.repeat, 3),
-                                gmsh_limit=limit)
+    sec = runner.run_mesh_suite(
+        names, meshers, quick=True, repeat=min(args.repeat, 3), gmsh_limit=limit
+    )
     store = out / "results.json"
     results = json.loads(store.read_text()) if store.exists() else {}
     results["realworld"] = sec
     store.write_text(json.dumps(results, indent=1))
-    text = ("Real-world group: per case aftmesh / Gmsh alg 6 / Triangle pq30a; RR = radius "
-            "ratio, time = median wall seconds.\n\n" + summary_table(sec))
+    text = (
+        "Real-world group: per case aftmesh / Gmsh alg 6 / Triangle pq30a; RR = radius "
+        "ratio, time = median wall seconds.\n\n" + summary_table(sec)
+    )
     (out / "realworld.md").write_text(text)
     print()
     print(text)

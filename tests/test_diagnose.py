@@ -1,4 +1,5 @@
 """aftmesh.diagnose: every bad triangle gets exactly one class, by the stated rules."""
+
 import numpy as np
 from shapely.geometry import Point, box
 

@@ -16,22 +16,22 @@
 * the compiled loop and the Python loop of Figure 5 give the same mesh; same input,
   same output.
 """
+
 from __future__ import annotations
 
+import domain_cases as dc
 import numpy as np
 import pytest
 import triangle
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from shapely.geometry import Polygon
 
 import aftmesh
 from aftmesh.aft import Strategy
 from aftmesh.checks import check_mesh, count_formula
-
-import domain_cases as dc
 
 # check_mesh's own empty-circle test uses the kernel's incircle predicate (it was not
 # exact at first: test_regression_check_mesh_incircle_not_exact).  The Delaunay
@@ -46,13 +46,31 @@ SAMPLE_CASES = [dc.triangle_sample(n) for n in dc.TRIANGLE_SAMPLES]
 # closed boundary curve per hole, except that a hole touching the exterior ring or
 # another hole at a vertex joins that curve (the paper's successor rule).
 EXPECTED_M = {
-    "square": [0], "ngon13": [0], "L": [0], "comb5": [0], "channel": [0],
-    "serpentine": [0], "9holes-square": [9], "16holes-circle": [16],
-    "hole-touch-vertex": [0], "hole-touch-edge": [0], "holes-touch": [1],
-    "touch-corner": [0, 0], "touch-vertex-edge": [0, 0], "annulus": [1],
-    "L+1e+06": [0], "annulus*1e-06": [1], "slot": [0], "spiral": [0], "sliver": [0],
-    "poly:A": [1], "poly:double_hex": [2], "poly:double_hex2": [2],
-    "poly:double_hex3": [2], "poly:face": [3], "poly:la": [0],
+    "square": [0],
+    "ngon13": [0],
+    "L": [0],
+    "comb5": [0],
+    "channel": [0],
+    "serpentine": [0],
+    "9holes-square": [9],
+    "16holes-circle": [16],
+    "hole-touch-vertex": [0],
+    "hole-touch-edge": [0],
+    "holes-touch": [1],
+    "touch-corner": [0, 0],
+    "touch-vertex-edge": [0, 0],
+    "annulus": [1],
+    "L+1e+06": [0],
+    "annulus*1e-06": [1],
+    "slot": [0],
+    "spiral": [0],
+    "sliver": [0],
+    "poly:A": [1],
+    "poly:double_hex": [2],
+    "poly:double_hex2": [2],
+    "poly:double_hex3": [2],
+    "poly:face": [3],
+    "poly:la": [0],
     "poly:square_circle_hole": [1],
 }
 
@@ -84,8 +102,11 @@ def assert_covers_boundary(mesh, edges) -> None:
         for p, q in ((a, b), (b, a)):
             ends.setdefault(tuple(p), []).append(q - p)
     for p, dirs in ends.items():
-        straight = len(dirs) == 2 and abs(dirs[0][0] * dirs[1][1] - dirs[0][1] * dirs[1][0]) \
-            <= 1e-12 * scale * scale and np.dot(dirs[0], dirs[1]) < 0
+        straight = (
+            len(dirs) == 2
+            and abs(dirs[0][0] * dirs[1][1] - dirs[0][1] * dirs[1][0]) <= 1e-12 * scale * scale
+            and np.dot(dirs[0], dirs[1]) < 0
+        )
         if not straight:
             assert (float(p[0]), float(p[1])) in mesh_pts, f"corner {p} was lost"
 
@@ -106,15 +127,17 @@ def assert_count_formula(mesh, expected_m=None) -> list:
     return rows
 
 
-def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=None,
-                 edges=None):
+def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=None, edges=None):
     """Everything a mesh of `case` must satisfy, whatever the options."""
     if case is not None:
         area = case.area if area is None else area
         edges = case.edges if edges is None else edges
-    check_mesh(mesh, domain_area=area,
-               input_segments=edges if not split_boundary else None,
-               delaunay=CHECKER_DELAUNAY and delaunay)
+    check_mesh(
+        mesh,
+        domain_area=area,
+        input_segments=edges if not split_boundary else None,
+        delaunay=CHECKER_DELAUNAY and delaunay,
+    )
     signs = dc.orient_signs(np.asarray(mesh.points), np.asarray(mesh.triangles))
     assert (signs > 0).all(), f"{int((signs <= 0).sum())} triangles not strictly CCW (exact)"
     if edges is not None:
@@ -123,10 +146,12 @@ def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=No
         else:
             # the paper's assumption: the input edges are edges of the mesh, unmodified
             # (only cut where another input vertex lies on them)
-            verts = case.vertices if case is not None else np.unique(
-                np.asarray(edges).reshape(-1, 2), axis=0)
-            assert dc.edge_keys(mesh.points, mesh.segments) == \
-                dc.split_at_vertices(edges, verts)
+            verts = (
+                case.vertices
+                if case is not None
+                else np.unique(np.asarray(edges).reshape(-1, 2), axis=0)
+            )
+            assert dc.edge_keys(mesh.points, mesh.segments) == dc.split_at_vertices(edges, verts)
     if edges is not None:
         # no near-duplicate vertices: no mesh edge is much shorter than both the
         # shortest input edge and the size (the pieces of an input edge are at least
@@ -151,8 +176,12 @@ def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=No
 
 
 def same_mesh(a, b) -> bool:
-    return (np.array_equal(a.points, b.points) and np.array_equal(a.triangles, b.triangles)
-            and np.array_equal(a.segments, b.segments) and np.array_equal(a.regions, b.regions))
+    return (
+        np.array_equal(a.points, b.points)
+        and np.array_equal(a.triangles, b.triangles)
+        and np.array_equal(a.segments, b.segments)
+        and np.array_equal(a.regions, b.regions)
+    )
 
 
 def graded(x, y):
@@ -184,6 +213,7 @@ def test_valid_mesh_callable_size(case):
 
     def size(x, y):
         return case.size * (0.4 + 0.8 * np.hypot(x - lo[0], y - lo[1]) / span)
+
     mesh = aftmesh.generate(case.domain, size)
     assert_valid(mesh, case)
 
@@ -209,16 +239,25 @@ def test_box_sample_encloses_nothing():
 
 
 @pytest.mark.parametrize("order", ["shortest", "longest", "oldest"])
-@pytest.mark.parametrize("case", [dc.comb(), dc.many_holes(3, "circle"), dc.annulus(),
-                                  dc.triangle_sample("A")], ids=repr)
+@pytest.mark.parametrize(
+    "case", [dc.comb(), dc.many_holes(3, "circle"), dc.annulus(), dc.triangle_sample("A")], ids=repr
+)
 def test_orders(case, order):
     mesh = aftmesh.generate(case.domain, case.size, order=order)
     assert_valid(mesh, case)
 
 
-@pytest.mark.parametrize("case", [dc.comb(), dc.many_holes(3, "square"), dc.serpentine(),
-                                  dc.corner_touching_parts(), dc.triangle_sample("la")],
-                         ids=repr)
+@pytest.mark.parametrize(
+    "case",
+    [
+        dc.comb(),
+        dc.many_holes(3, "square"),
+        dc.serpentine(),
+        dc.corner_touching_parts(),
+        dc.triangle_sample("la"),
+    ],
+    ids=repr,
+)
 def test_without_swaps_still_valid(case):
     """Without the Delaunay swaps of Add_triangle the mesh need not be Delaunay, but it
     is a valid triangulation and formula (6) holds."""
@@ -234,10 +273,15 @@ def test_boundary_discretization_does_not_depend_on_the_interior():
         full = aftmesh.generate(case.domain, size)
         greedy = aftmesh.generate(case.domain, size, greedy=True)
         assert_valid(greedy, case)
-        assert dc.edge_keys(full.points, full.segments) == \
-            dc.edge_keys(greedy.points, greedy.segments)
-        check_mesh(full, domain_area=case.area, input_segments=segment_coords(greedy),
-                   delaunay=CHECKER_DELAUNAY)
+        assert dc.edge_keys(full.points, full.segments) == dc.edge_keys(
+            greedy.points, greedy.segments
+        )
+        check_mesh(
+            full,
+            domain_area=case.area,
+            input_segments=segment_coords(greedy),
+            delaunay=CHECKER_DELAUNAY,
+        )
 
 
 # ---------------------------------------------------------------------- greedy
@@ -272,15 +316,23 @@ def test_greedy_triangle_samples(case):
     assert_valid(mesh, case, split_boundary=False)
     assert dc.coordinate_keys(mesh.points) == dc.coordinate_keys(case.vertices)
     d = case.domain
-    ref = triangle.triangulate({k: d[k] for k in ("vertices", "segments", "holes") if k in d},
-                               "p")
+    ref = triangle.triangulate({k: d[k] for k in ("vertices", "segments", "holes") if k in d}, "p")
     assert len(mesh.triangles) == len(ref["triangles"])
 
 
 # ------------------------------------------------------------------ N_max, A_min
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "square"),
-                                  dc.corner_touching_parts(), dc.hole_touching_boundary(),
-                                  dc.triangle_sample("double_hex3")], ids=repr)
+@pytest.mark.parametrize(
+    "case",
+    [
+        dc.square(),
+        dc.l_shape(),
+        dc.many_holes(3, "square"),
+        dc.corner_touching_parts(),
+        dc.hole_touching_boundary(),
+        dc.triangle_sample("double_hex3"),
+    ],
+    ids=repr,
+)
 def test_max_triangles(case):
     greedy = aftmesh.generate(case.domain, case.size, greedy=True)
     full = aftmesh.generate(case.domain, case.size)
@@ -328,17 +380,17 @@ class SizeConstraintRecorder(Strategy):
         return refuse
 
 
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "circle")],
-                         ids=repr)
+@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "circle")], ids=repr)
 @pytest.mark.parametrize("factor", [0.5, 1.0, 1.5])
 def test_min_area_formula_5(case, factor):
     """Formula (5): a new vertex only when A(E, R) >= A_min.  With smoothing off every
     new vertex of the mesh is one of the R's that Mesh_size_constraint let through."""
-    a_min = factor * (np.sqrt(3) / 4) * case.size ** 2
+    a_min = factor * (np.sqrt(3) / 4) * case.size**2
     rec = SizeConstraintRecorder()
     # (min_angle=None: the refinement pass adds vertices of its own after Basic_aft)
-    mesh = aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0, strategy=rec,
-                            min_angle=None)
+    mesh = aftmesh.generate(
+        case.domain, case.size, min_area=a_min, smooth=0, strategy=rec, min_angle=None
+    )
     assert_valid(mesh, case)
     assert rec.asked
     for x, y, area, refused in rec.asked:
@@ -351,22 +403,23 @@ def test_min_area_formula_5(case, factor):
     assert len(new_pts) == mesh.info["new_vertices"]
     assert new_pts <= allowed
     # same mesh as the compiled loop
-    assert same_mesh(mesh, aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0,
-                                            min_angle=None))
+    assert same_mesh(
+        mesh, aftmesh.generate(case.domain, case.size, min_area=a_min, smooth=0, min_angle=None)
+    )
 
 
-@pytest.mark.parametrize("case", [dc.square(), dc.comb(), dc.many_holes(3, "circle"),
-                                  dc.triangle_sample("A")], ids=repr)
+@pytest.mark.parametrize(
+    "case", [dc.square(), dc.comb(), dc.many_holes(3, "circle"), dc.triangle_sample("A")], ids=repr
+)
 def test_min_area_fewer_vertices(case):
     """A_min refuses new vertices: a small A_min still lets the front add vertices,
     one above the area of an equilateral triangle of the size (every candidate
     triangle is about that, or smaller) refuses them all.  (Counts at different
     small A_min need not be monotone: the front evolves differently.)"""
-    base = (np.sqrt(3) / 4) * case.size ** 2
+    base = (np.sqrt(3) / 4) * case.size**2
     counts = []
     for factor in (0.0, 0.3, 3.0, 30.0):
-        mesh = aftmesh.generate(case.domain, case.size, min_area=factor * base,
-                                min_angle=None)
+        mesh = aftmesh.generate(case.domain, case.size, min_area=factor * base, min_angle=None)
         assert_valid(mesh, case)
         counts.append(mesh.info["new_vertices"])
     assert counts[0] > 0 and counts[1] > 0, counts
@@ -405,13 +458,24 @@ class SameGetNextEdge(Strategy):
         return kernel.get_next_edge()
 
 
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.comb(3),
-                                  dc.many_holes(3, "circle"), dc.hole_touching_boundary(),
-                                  dc.corner_touching_parts(), dc.triangle_sample("face")],
-                         ids=repr)
-@pytest.mark.parametrize("options", [{}, {"order": "longest"}, {"order": "oldest"},
-                                     {"swaps": False}, {"size": graded}],
-                         ids=["default", "longest", "oldest", "noswaps", "graded"])
+@pytest.mark.parametrize(
+    "case",
+    [
+        dc.square(),
+        dc.l_shape(),
+        dc.comb(3),
+        dc.many_holes(3, "circle"),
+        dc.hole_touching_boundary(),
+        dc.corner_touching_parts(),
+        dc.triangle_sample("face"),
+    ],
+    ids=repr,
+)
+@pytest.mark.parametrize(
+    "options",
+    [{}, {"order": "longest"}, {"order": "oldest"}, {"swaps": False}, {"size": graded}],
+    ids=["default", "longest", "oldest", "noswaps", "graded"],
+)
 def test_python_loop_same_as_compiled(case, options):
     options = dict(options)
     size = options.pop("size", case.size)
@@ -482,13 +546,22 @@ class HighestEdgeFirst(Strategy):
         return best
 
 
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "circle"),
-                                  dc.triangle_sample("face"), dc.triangle_sample("A")],
-                         ids=repr)
+@pytest.mark.parametrize(
+    "case",
+    [
+        dc.square(),
+        dc.l_shape(),
+        dc.many_holes(3, "circle"),
+        dc.triangle_sample("face"),
+        dc.triangle_sample("A"),
+    ],
+    ids=repr,
+)
 def test_strategy_never_new_is_greedy(case):
     for split in (False, True):
-        mesh = aftmesh.generate(case.domain, case.size, strategy=NeverNew(),
-                                split_boundary=split, min_angle=None)
+        mesh = aftmesh.generate(
+            case.domain, case.size, strategy=NeverNew(), split_boundary=split, min_angle=None
+        )
         assert mesh.info["compiled_loop"] is False
         assert_valid(mesh, case, split_boundary=split)
         greedy = aftmesh.generate(case.domain, case.size, greedy=True, split_boundary=split)
@@ -496,18 +569,21 @@ def test_strategy_never_new_is_greedy(case):
         assert mesh.info["new_vertices"] == 0
 
 
-@pytest.mark.parametrize("strategy", [FlatCandidate, FarCandidate, HighestEdgeFirst],
-                         ids=lambda s: s.__name__)
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.hole_touching_boundary(),
-                                  dc.holes_touching_each_other()], ids=repr)
+@pytest.mark.parametrize(
+    "strategy", [FlatCandidate, FarCandidate, HighestEdgeFirst], ids=lambda s: s.__name__
+)
+@pytest.mark.parametrize(
+    "case",
+    [dc.square(), dc.l_shape(), dc.hole_touching_boundary(), dc.holes_touching_each_other()],
+    ids=repr,
+)
 def test_custom_strategies_give_valid_meshes(case, strategy):
     mesh = aftmesh.generate(case.domain, case.size, strategy=strategy())
     assert mesh.info["compiled_loop"] is False
     assert_valid(mesh, case)
 
 
-@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "square")],
-                         ids=repr)
+@pytest.mark.parametrize("case", [dc.square(), dc.l_shape(), dc.many_holes(3, "square")], ids=repr)
 def test_always_new_with_max_triangles(case):
     """Any New_is_preferred is allowed; formula (4) still bounds the mesh."""
     g = len(aftmesh.generate(case.domain, case.size, greedy=True).triangles)
@@ -521,22 +597,24 @@ def test_strategy_that_stops_early_is_an_error():
     class Quitter(Strategy):
         def get_next_edge(self, kernel):
             return -1
+
     with pytest.raises(aftmesh.InvalidOptionError):
         aftmesh.generate(dc.square().domain, 0.2, strategy=Quitter())
 
 
 # ------------------------------------------------------------------ determinism
-@pytest.mark.parametrize("case", [dc.comb(), dc.many_holes(4, "circle"),
-                                  dc.vertex_on_edge_parts(), dc.triangle_sample("la")],
-                         ids=repr)
+@pytest.mark.parametrize(
+    "case",
+    [dc.comb(), dc.many_holes(4, "circle"), dc.vertex_on_edge_parts(), dc.triangle_sample("la")],
+    ids=repr,
+)
 def test_deterministic(case):
     runs = [aftmesh.generate(case.domain, case.size) for _ in range(2)]
     runs.append(aftmesh.generate(case.domain, graded))
     runs.append(aftmesh.generate(case.domain, graded))
     for a, b in (runs[:2], runs[2:]):
         assert_valid(a, case)
-        for name in ("points", "triangles", "neighbors", "segments", "regions",
-                     "segment_markers"):
+        for name in ("points", "triangles", "neighbors", "segments", "regions", "segment_markers"):
             assert getattr(a, name).tobytes() == getattr(b, name).tobytes(), name
 
 
@@ -546,21 +624,32 @@ def test_deterministic_across_processes():
     import os
     import subprocess
     import sys
-    code = ("import hashlib, numpy as np, aftmesh, sys; sys.path.insert(0, 'tests');"
-            "import domain_cases as dc; c = dc.many_holes(3, 'circle');"
-            "m = aftmesh.generate(c.domain, c.size);"
-            "h = hashlib.sha256(); [h.update(np.ascontiguousarray(a).tobytes()) for a in "
-            "(m.points, m.triangles, m.segments)]; print(h.hexdigest())")
+
+    code = (
+        "import hashlib, numpy as np, aftmesh, sys; sys.path.insert(0, 'tests');"
+        "import domain_cases as dc; c = dc.many_holes(3, 'circle');"
+        "m = aftmesh.generate(c.domain, c.size);"
+        "h = hashlib.sha256(); [h.update(np.ascontiguousarray(a).tobytes()) for a in "
+        "(m.points, m.triangles, m.segments)]; print(h.hexdigest())"
+    )
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     # the child imports the same aftmesh as this process (installed or from src/)
     package_root = os.path.dirname(os.path.dirname(os.path.abspath(aftmesh.__file__)))
     digests = set()
     for seed in ("0", "12345"):
-        env = dict(os.environ, PYTHONHASHSEED=seed,
-                   PYTHONPATH=os.pathsep.join([package_root,
-                                               os.environ.get("PYTHONPATH", "")]))
-        out = subprocess.run([sys.executable, "-c", code], cwd=here, env=env,
-                             capture_output=True, text=True, timeout=120)
+        env = dict(
+            os.environ,
+            PYTHONHASHSEED=seed,
+            PYTHONPATH=os.pathsep.join([package_root, os.environ.get("PYTHONPATH", "")]),
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", code],
+            cwd=here,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
         assert out.returncode == 0, out.stderr
         digests.add(out.stdout.strip())
     c = dc.many_holes(3, "circle")
@@ -623,8 +712,11 @@ def test_random_circular_holes_greedy(poly):
 
 
 @settings(max_examples=12)
-@given(poly=dc.star_polygons(max_vertices=10), size=st.sampled_from([0.2, "graded"]),
-       order=st.sampled_from(["shortest", "longest", "oldest"]))
+@given(
+    poly=dc.star_polygons(max_vertices=10),
+    size=st.sampled_from([0.2, "graded"]),
+    order=st.sampled_from(["shortest", "longest", "oldest"]),
+)
 def test_random_python_loop_same_as_compiled(poly, size, order):
     compiled = aftmesh.generate(poly, _size(size), order=order)
     python = aftmesh.generate(poly, _size(size), order=order, strategy=SameGetNextEdge())
@@ -633,9 +725,11 @@ def test_random_python_loop_same_as_compiled(poly, size, order):
 
 
 @settings(max_examples=25)
-@given(poly=dc.polygons_with_circular_holes(max_holes=3),
-       order=st.sampled_from(["shortest", "longest", "oldest"]),
-       slack=st.integers(0, 60))
+@given(
+    poly=dc.polygons_with_circular_holes(max_holes=3),
+    order=st.sampled_from(["shortest", "longest", "oldest"]),
+    slack=st.integers(0, 60),
+)
 def test_random_circular_holes_options(poly, order, slack):
     case = dc.shapely_case("holes", poly, 0.3)
     g = len(aftmesh.generate(poly, 0.3, greedy=True).triangles)
@@ -655,10 +749,14 @@ def test_regression_check_mesh_incircle_not_exact():
     """check_mesh reports an exactly cocircular pair of triangles as non-Delaunay:
     its incircle predicate (the kernel's) rounds instead of being exact."""
     P = _cocircular_mirror_quad()
-    assert dc.incircle_signs(P, np.array([[0, 1, 2, 3]]))[0] == 0   # exact: cocircular
-    mesh = aftmesh.Mesh(points=P, triangles=[[0, 1, 2], [0, 2, 3]],
-                        neighbors=[[-1, 1, -1], [-1, -1, 0]],
-                        segments=[[0, 1], [1, 2], [2, 3], [3, 0]], regions=[0, 0])
+    assert dc.incircle_signs(P, np.array([[0, 1, 2, 3]]))[0] == 0  # exact: cocircular
+    mesh = aftmesh.Mesh(
+        points=P,
+        triangles=[[0, 1, 2], [0, 2, 3]],
+        neighbors=[[-1, 1, -1], [-1, -1, 0]],
+        segments=[[0, 1], [1, 2], [2, 3], [3, 0]],
+        regions=[0, 0],
+    )
     check_mesh(mesh, domain_area=Polygon(P).area, delaunay=True)
 
 
@@ -667,8 +765,7 @@ def test_regression_greedy_not_cdt_double_hex():
     from cd(S(E))), but two triangles have the apex of their neighbour strictly inside
     their circumcircle in exact arithmetic: near-cocircular points on the rings, decided
     by the non-exact incircle when the initial CDT is built."""
-    mesh = aftmesh.generate(triangle.get_data("double_hex"), greedy=True,
-                            split_boundary=False)
+    mesh = aftmesh.generate(triangle.get_data("double_hex"), greedy=True, split_boundary=False)
     assert dc.non_delaunay_edges(mesh) == []
 
 

@@ -7,6 +7,7 @@ small input angle is one of them).  Angles are compared exactly (rationals) wher
 float comparison is within 1e-9 of the bound.  Every mesh also passes check_mesh, the
 CDT oracle and formula (6)'s count.
 """
+
 from __future__ import annotations
 
 import math
@@ -67,7 +68,7 @@ def below_bound(mesh, bound: float) -> list[tuple[int, int]]:
 def _on_each(x, edges, tol) -> np.ndarray:
     a, b = edges[:, 0], edges[:, 1]
     d = b - a
-    L2 = (d ** 2).sum(1)
+    L2 = (d**2).sum(1)
     rel = x - a
     t = (rel * d).sum(1) / L2
     dist = np.abs(rel[:, 0] * d[:, 1] - rel[:, 1] * d[:, 0]) / np.sqrt(L2)
@@ -111,8 +112,10 @@ def assert_guarantee(mesh, edges, bound, *, area=None) -> dict:
     unforced = [t for t in sorted(bad) if not forced(mesh, t, np.asarray(edges, float), bound)]
     if unforced:
         example = np.asarray(mesh.points)[mesh.triangles[unforced[0]]].tolist()
-        raise AssertionError(f"{len(unforced)} triangles below {bound} not forced by an "
-                             f"input angle, e.g. {example}; {info}")
+        raise AssertionError(
+            f"{len(unforced)} triangles below {bound} not forced by an "
+            f"input angle, e.g. {example}; {info}"
+        )
     assert info["reached"] and info["unresolved_triangles"] == 0, info
     return info
 
@@ -181,6 +184,7 @@ def test_slanted_boundary_on_the_hull_is_split(angle, size):
     boundary, with no double in them where the next split must go; the pass then puts
     the point an ulp into the domain (the sliver joins the exterior)."""
     import shapely.affinity
+
     poly = shapely.affinity.rotate(box(0, 0, 10, 0.05), angle, origin=(0, 0))
     case = dc.shapely_case("slanted-channel", poly, size)
     mesh = aftmesh.generate(poly, size, min_angle=33.0)
@@ -195,7 +199,8 @@ def _fan(n_lines: int, step_deg: float):
     lines = []
     for k in range(n_lines):
         th = math.radians(60.0 + k * step_deg)
-        lines.append(LineString([tuple(c), tuple(c + 0.8 * np.array([math.cos(th), math.sin(th)]))]))
+        tip = c + 0.8 * np.array([math.cos(th), math.sin(th)])
+        lines.append(LineString([tuple(c), tuple(tip)]))
     return GeometryCollection([box(0, 0, 1, 1), *lines])
 
 
@@ -215,7 +220,7 @@ def test_fan_of_small_angles_terminates(step):
     assert info["stopped_by"] is None
 
 
-@pytest.mark.parametrize("eps", [1e-6, 1e-12, 2.0 ** -52])
+@pytest.mark.parametrize("eps", [1e-6, 1e-12, 2.0**-52])
 def test_nearly_collinear_boundary_terminates(eps):
     poly = Polygon([(0, 0), (1, eps), (2, 0), (2, 1), (0, 1)])
     case = dc.shapely_case("near-collinear", poly, 0.2)
@@ -223,7 +228,7 @@ def test_nearly_collinear_boundary_terminates(eps):
     assert_guarantee(mesh, case.edges, 30.0, area=case.area)
 
 
-@pytest.mark.parametrize("width", [1e-3, 1e-9, 2.0 ** -50])
+@pytest.mark.parametrize("width", [1e-3, 1e-9, 2.0**-50])
 def test_needle_terminates(width):
     poly = Polygon([(0, 0), (10, 0), (10, width)])
     case = dc.shapely_case("needle", poly, 1.0)
@@ -264,8 +269,9 @@ def test_pass_respects_unsplit_boundary():
     case = dc.l_shape()
     mesh = aftmesh.generate(case.domain, case.size, split_boundary=False, min_angle=33.0)
     check_mesh(mesh, domain_area=case.area, input_segments=case.edges)
-    assert dc.edge_keys(mesh.points, mesh.segments) == dc.split_at_vertices(case.edges,
-                                                                            case.vertices)
+    assert dc.edge_keys(mesh.points, mesh.segments) == dc.split_at_vertices(
+        case.edges, case.vertices
+    )
     assert mesh.info["min_angle"]["segment_splits"] == 0
 
 
@@ -276,8 +282,10 @@ def test_regions_and_exterior_keep_their_state():
     check_mesh(mesh, domain_area=2.0)
     dc.assert_cdt(mesh)
     P = np.asarray(mesh.points)[np.asarray(mesh.triangles)]
-    area = 0.5 * np.abs((P[:, 1, 0] - P[:, 0, 0]) * (P[:, 2, 1] - P[:, 0, 1])
-                        - (P[:, 1, 1] - P[:, 0, 1]) * (P[:, 2, 0] - P[:, 0, 0]))
+    area = 0.5 * np.abs(
+        (P[:, 1, 0] - P[:, 0, 0]) * (P[:, 2, 1] - P[:, 0, 1])
+        - (P[:, 1, 1] - P[:, 0, 1]) * (P[:, 2, 0] - P[:, 0, 0])
+    )
     for r in np.unique(mesh.regions):
         assert abs(area[mesh.regions == r].sum() - 1.0) < 1e-9
     assert mesh.info["min_angle"]["reached"]

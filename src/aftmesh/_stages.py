@@ -331,6 +331,7 @@ def boundary_tags(dom: Domain, opts: Options):
     Resolved before any meshing, so a bad selector fails fast."""
     if opts.boundary_tags is None:
         return None
+    assert dom.edge_midpoints is not None  # both Domain constructors set it
     return resolve_boundary_tags(
         opts.boundary_tags,
         dom.edge_midpoints,

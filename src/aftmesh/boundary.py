@@ -29,7 +29,7 @@ def discretize(
     max_pieces: int | None = None,
     limit: str = "",
     clear: float = 0.0,
-):
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Return (vertices, segments, source) with long segments split by the size.
 
     Raises InvalidSizeError, before allocating anything, if the boundary alone would

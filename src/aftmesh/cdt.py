@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from .domain import node_crossings
 from .errors import InvalidOptionError
@@ -15,7 +16,14 @@ __all__ = ["cdt"]
 CROSSINGS = ("raise", "split")
 
 
-def cdt(vertices, segments=None, *, holes=None, regions=None, crossings="raise") -> Mesh:
+def cdt(
+    vertices: npt.ArrayLike,
+    segments: npt.ArrayLike | None = None,
+    *,
+    holes: npt.ArrayLike | None = None,
+    regions: npt.ArrayLike | None = None,
+    crossings: str = "raise",
+) -> Mesh:
     """Constrained Delaunay triangulation of a planar straight-line graph.
 
     No point is added, unless ``crossings="split"``.  A segment that runs exactly

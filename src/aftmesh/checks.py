@@ -249,7 +249,7 @@ def boundary_curves(points: np.ndarray, triangles: np.ndarray) -> int:
     return curves
 
 
-def count_formula(mesh: Mesh):
+def count_formula(mesh: Mesh) -> list[tuple[int, int, int, int]]:
     """Per connected component of the mesh: (T, E_b, V_i, m), with m + 1 the number of
     its boundary curves (see :func:`boundary_curves`).  The appendix's formula (6)
     states T = E_b + 2 V_i + 2 (m - 1)."""

@@ -28,13 +28,16 @@ neither adds nor removes any, and the Python loop gives the compiled loop's mesh
 diagnoses Basic_aft and smoothing, before the minimum-angle pass (``min_angle=None``
 unless given: the pass adds vertices of its own).
 """
+
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from ._typing import DomainArg, SizeArg
 from .aft import Strategy
 from .generate import generate
 from .mesh import Mesh, triangle_quality
@@ -42,8 +45,8 @@ from .mesh import Mesh, triangle_quality
 __all__ = ["CLASSES", "Diagnosis", "diagnose"]
 
 CLASSES = ("smoothing", "boundary", "size", "collision", "other")
-SIZE_RATIO = 1.3         # size field max / min over one triangle: a transition
-NEIGHBOUR_RATIO = 1.5    # mean edge length of a triangle against a neighbour's
+SIZE_RATIO = 1.3  # size field max / min over one triangle: a transition
+NEIGHBOUR_RATIO = 1.5  # mean edge length of a triangle against a neighbour's
 OPPOSING_DEGREES = 120.0  # front normals this far apart came from opposite sides
 
 
@@ -52,7 +55,7 @@ class _Recorder(Strategy):
 
     def __init__(self):
         self.pending = None
-        self.bridges: list[tuple] = []       # coordinates of T(E, S) for 1- and 3-front steps
+        self.bridges: list[tuple] = []  # coordinates of T(E, S) for 1- and 3-front steps
         self.normals: dict[tuple, float] = {}  # new vertex -> angle of E's normal
 
     def get_next_edge(self, kernel) -> int:
@@ -64,8 +67,13 @@ class _Recorder(Strategy):
             prv = E + 2 if E % 3 == 0 else E - 1
             fronts = 1 + kernel.is_front(nxt) + kernel.is_front(prv)
             S = kernel.compute_existing_candidate(E)
-            self.pending = (kernel.vertex(a), kernel.vertex(b), kernel.vertex(S), fronts,
-                            kernel.n_vertices)
+            self.pending = (
+                kernel.vertex(a),
+                kernel.vertex(b),
+                kernel.vertex(S),
+                fronts,
+                kernel.n_vertices,
+            )
         return E
 
     def _finish(self, kernel) -> None:
@@ -73,7 +81,7 @@ class _Recorder(Strategy):
             return
         pa, pb, ps, fronts, nv = self.pending
         self.pending = None
-        if kernel.n_vertices > nv:            # Update_internal added R
+        if kernel.n_vertices > nv:  # Update_internal added R
             self.normals[kernel.vertex(nv)] = math.atan2(pb[0] - pa[0], -(pb[1] - pa[1]))
         elif fronts != 2:
             self.bridges.append((pa, pb, ps))
@@ -85,8 +93,8 @@ class Diagnosis:
 
     mesh: Mesh
     threshold: float
-    bad: np.ndarray                       # (k,) triangle indices
-    labels: np.ndarray                    # (k,) class names
+    bad: np.ndarray  # (k,) triangle indices
+    labels: np.ndarray  # (k,) class names
     counts: dict[str, int] = field(default_factory=dict)
 
     def summary(self) -> str:
@@ -113,7 +121,7 @@ def _bad_around(tris: np.ndarray, bad: np.ndarray, n_points: int) -> np.ndarray:
 def _size_transition(mesh: Mesh, q: dict) -> np.ndarray:
     p, t = mesh.points, mesh.triangles
     corners = np.concatenate([p[t], p[t].mean(axis=1, keepdims=True)], axis=1)
-    field_ = mesh.info.get("size_field")
+    field_ = mesh.info["size_field"]  # generate always records it
     hs = np.asarray(field_(corners[..., 0].ravel(), corners[..., 1].ravel())).reshape(-1, 4)
     by_field = hs.max(axis=1) > SIZE_RATIO * hs.min(axis=1)
     mean_edge = q["edge_lengths"].mean(axis=1)
@@ -146,7 +154,9 @@ def _collision(mesh: Mesh, rec: _Recorder, index: dict) -> np.ndarray:
     return by_bridge | opposing
 
 
-def diagnose(domain, size=None, *, threshold: float = 0.9, **options) -> Diagnosis:
+def diagnose(
+    domain: DomainArg, size: SizeArg = None, *, threshold: float = 0.9, **options: Any
+) -> Diagnosis:
     """Mesh ``domain`` with ``generate(domain, size, **options)`` and label its
     triangles with radius ratio below ``threshold`` by cause (see the module's
     docstring for the classes and the heuristics).
@@ -172,12 +182,14 @@ def diagnose(domain, size=None, *, threshold: float = 0.9, **options) -> Diagnos
     on_segment = np.zeros(len(mesh.points), dtype=bool)
     on_segment[mesh.segments.ravel()] = True
     t = mesh.triangles[bad]
-    tests = {"smoothing": ~was_bad[t].any(axis=1),
-             "boundary": on_segment[t].any(axis=1),
-             "size": _size_transition(mesh, q)[bad],
-             "collision": _collision(mesh, rec, index)[bad]}
+    tests = {
+        "smoothing": ~was_bad[t].any(axis=1),
+        "boundary": on_segment[t].any(axis=1),
+        "size": _size_transition(mesh, q)[bad],
+        "collision": _collision(mesh, rec, index)[bad],
+    }
     labels = np.full(len(bad), "other", dtype=object)
-    for name in reversed(list(tests)):          # the first class that applies wins
+    for name in reversed(list(tests)):  # the first class that applies wins
         labels[tests[name]] = name
     counts = {c: int((labels == c).sum()) for c in CLASSES}
     return Diagnosis(mesh, threshold, bad, labels.astype(str), counts)

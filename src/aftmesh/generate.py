@@ -2,11 +2,16 @@
 
 The body is the data flow of ARCHITECTURE.md, one stage per call (see ``_stages``).
 """
+
 from __future__ import annotations
 
 import time
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any, overload
 
 from . import _stages
+from ._typing import DomainArg, PathArg, SizeArg
 from .aft import Strategy
 from .domain import to_domain
 from .errors import InvalidDomainError
@@ -18,19 +23,100 @@ __all__ = ["generate"]
 
 # generate's options that a partitioned run passes on (partition.py decides which
 # reach the parts and which only the run that discretizes the whole boundary)
-_FORWARD = ("max_triangles", "min_area", "order", "greedy", "swaps", "split_boundary",
-            "gradation", "close_factor", "smooth", "strategy", "progress", "repair",
-            "tolerance", "boundary_tags", "min_angle")
+_FORWARD = (
+    "max_triangles",
+    "min_area",
+    "order",
+    "greedy",
+    "swaps",
+    "split_boundary",
+    "gradation",
+    "close_factor",
+    "smooth",
+    "strategy",
+    "progress",
+    "repair",
+    "tolerance",
+    "boundary_tags",
+    "min_angle",
+)
 
 
-def generate(domain, size=None, *, max_triangles: int | None = None,
-             min_area: float | None = None, order: str = "shortest", greedy: bool = False,
-             swaps: bool = True, split_boundary: bool = True,
-             gradation: float = DEFAULT_GRADATION, close_factor: float = 0.5,
-             smooth: int = 3, strategy: Strategy | None = None, progress=None,
-             repair: bool = False, tolerance: float = 0.0, boundary_tags=None,
-             min_angle: float | None = DEFAULT_MIN_ANGLE, partitions: int | None = None,
-             client=None, out=None) -> Mesh:
+@overload
+def generate(
+    domain: DomainArg,
+    size: SizeArg = None,
+    *,
+    max_triangles: int | None = None,
+    min_area: float | None = None,
+    order: str = "shortest",
+    greedy: bool = False,
+    swaps: bool = True,
+    split_boundary: bool = True,
+    gradation: float = DEFAULT_GRADATION,
+    close_factor: float = 0.5,
+    smooth: int = 3,
+    strategy: Strategy | None = None,
+    progress: bool | Callable[[float], object] | None = None,
+    repair: bool = False,
+    tolerance: float = 0.0,
+    boundary_tags: Mapping[str, Any] | None = None,
+    min_angle: float | None = DEFAULT_MIN_ANGLE,
+    partitions: int | None = None,
+    client: Any = None,
+    out: None = None,
+) -> Mesh: ...
+
+
+@overload
+def generate(
+    domain: DomainArg,
+    size: SizeArg = None,
+    *,
+    max_triangles: int | None = None,
+    min_area: float | None = None,
+    order: str = "shortest",
+    greedy: bool = False,
+    swaps: bool = True,
+    split_boundary: bool = True,
+    gradation: float = DEFAULT_GRADATION,
+    close_factor: float = 0.5,
+    smooth: int = 3,
+    strategy: Strategy | None = None,
+    progress: bool | Callable[[float], object] | None = None,
+    repair: bool = False,
+    tolerance: float = 0.0,
+    boundary_tags: Mapping[str, Any] | None = None,
+    min_angle: float | None = DEFAULT_MIN_ANGLE,
+    partitions: int | None = None,
+    client: Any = None,
+    out: PathArg,
+) -> Path: ...
+
+
+def generate(
+    domain: DomainArg,
+    size: SizeArg = None,
+    *,
+    max_triangles: int | None = None,
+    min_area: float | None = None,
+    order: str = "shortest",
+    greedy: bool = False,
+    swaps: bool = True,
+    split_boundary: bool = True,
+    gradation: float = DEFAULT_GRADATION,
+    close_factor: float = 0.5,
+    smooth: int = 3,
+    strategy: Strategy | None = None,
+    progress: bool | Callable[[float], object] | None = None,
+    repair: bool = False,
+    tolerance: float = 0.0,
+    boundary_tags: Mapping[str, Any] | None = None,
+    min_angle: float | None = DEFAULT_MIN_ANGLE,
+    partitions: int | None = None,
+    client: Any = None,
+    out: PathArg | None = None,
+) -> Mesh | Path:
     """Mesh a 2D domain with triangles by the advancing-front technique.
 
     Parameters
@@ -48,9 +134,9 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
         with two 1-D float arrays ``x``, ``y`` of equal length (many points at once,
         never one call per point), and must return an array of that length (one size
         per point) or a single number; any other shape raises InvalidSizeError.  So
-        ``lambda x, y: h(np.c_[x, y])`` works for any ``h`` taking (n, 2) points.  A size must span at least 64 units in
-        the last place of the largest coordinate (about 1e-14 of it); a finer one
-        raises InvalidSizeError.
+        ``lambda x, y: h(np.c_[x, y])`` works for any ``h`` taking (n, 2) points.
+        A size must span at least 64 units in the last place of the largest
+        coordinate (about 1e-14 of it); a finer one raises InvalidSizeError.
     max_triangles : int, optional
         N_max: the mesh never has more triangles (formula (4) of the paper).
     min_area : float, optional
@@ -172,19 +258,33 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     """
     if partitions is not None or client is not None or out is not None:
         from .partition import generate_partitioned
+
         options = {k: v for k, v in locals().items() if k in _FORWARD}
         k = 1 if partitions is None else partitions
-        return generate_partitioned(domain, size, partitions=k, client=client, out=out,
-                                    options=options)
+        return generate_partitioned(
+            domain, size, partitions=k, client=client, out=out, options=options
+        )
     t_start = time.perf_counter()
-    opts = check_options(order=order, max_triangles=max_triangles, min_area=min_area,
-                         greedy=greedy, swaps=swaps, split_boundary=split_boundary,
-                         gradation=gradation, close_factor=close_factor, smooth=smooth,
-                         strategy=strategy, progress=progress, repair=repair,
-                         tolerance=tolerance, boundary_tags=boundary_tags,
-                         min_angle=min_angle)
-    dom = to_domain(domain, keep_vertices=not opts.split_boundary,
-                    tolerance=opts.tolerance, repair=opts.repair)
+    opts = check_options(
+        order=order,
+        max_triangles=max_triangles,
+        min_area=min_area,
+        greedy=greedy,
+        swaps=swaps,
+        split_boundary=split_boundary,
+        gradation=gradation,
+        close_factor=close_factor,
+        smooth=smooth,
+        strategy=strategy,
+        progress=progress,
+        repair=repair,
+        tolerance=tolerance,
+        boundary_tags=boundary_tags,
+        min_angle=min_angle,
+    )
+    dom = to_domain(
+        domain, keep_vertices=not opts.split_boundary, tolerance=opts.tolerance, repair=opts.repair
+    )
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
     edge_tags = _stages.boundary_tags(dom, opts)
@@ -198,9 +298,12 @@ def generate(domain, size=None, *, max_triangles: int | None = None,
     t_aft = time.perf_counter()
     refined = _stages.refine(kernel, dom, opts)
     t_refine = time.perf_counter()
-    timing = {"boundary": t_boundary - t_start, "cdt": t_cdt - t_boundary,
-              "basic_aft": t_aft - t_cdt, "min_angle": t_refine - t_aft}
-    mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing, edge_tags,
-                            refined)
+    timing = {
+        "boundary": t_boundary - t_start,
+        "cdt": t_cdt - t_boundary,
+        "basic_aft": t_aft - t_cdt,
+        "min_angle": t_refine - t_aft,
+    }
+    mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing, edge_tags, refined)
     timing["total"] = time.perf_counter() - t_start
     return mesh

@@ -28,6 +28,7 @@ from shapely.geometry import (
     Polygon,
 )
 
+from ._typing import DomainArg, PathArg
 from .errors import InvalidDomainError, InvalidInputError
 from .noding import merge_and_node, merge_close_segments, refuse_crossings, split_at_vertices
 from .pslg import as_points, as_segments, check_range
@@ -274,7 +275,7 @@ def from_dict(d: dict, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     )
 
 
-def from_poly_file(path, presplit: bool = True, tolerance: float = 0.0) -> Domain:
+def from_poly_file(path: PathArg, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     """A Triangle ``.poly`` file: read into a dict, then as :func:`from_dict`."""
     from .io import read_poly
 
@@ -311,7 +312,7 @@ def _split_geometry(domain):
     return polygons, lines, line_names, points
 
 
-def from_geometry(domain, tolerance: float = 0.0) -> Domain:
+def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     """A shapely Polygon / MultiPolygon / GeometryCollection (its lines and points
     are internal constraints)."""
     polygons, lines, line_names, points = _split_geometry(domain)
@@ -384,7 +385,7 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
     return dom
 
 
-def is_coordinate_array(obj) -> bool:
+def is_coordinate_array(obj: object) -> bool:
     if isinstance(obj, (str, bytes, dict)) or isinstance(obj, shapely.Geometry):
         return False
     try:
@@ -394,7 +395,7 @@ def is_coordinate_array(obj) -> bool:
     return arr.ndim == 2 and arr.shape[1] == 2
 
 
-def polygon_parts(geom, where: str) -> list[Polygon]:
+def polygon_parts(geom: shapely.Geometry, where: str) -> list[Polygon]:
     if isinstance(geom, Polygon):
         return [geom]
     if isinstance(geom, MultiPolygon):
@@ -403,7 +404,11 @@ def polygon_parts(geom, where: str) -> list[Polygon]:
 
 
 def to_domain(
-    domain, *, keep_vertices: bool = False, tolerance: float = 0.0, repair: bool = False
+    domain: DomainArg,
+    *,
+    keep_vertices: bool = False,
+    tolerance: float = 0.0,
+    repair: bool = False,
 ) -> Domain:
     """Convert any accepted domain form into a :class:`Domain` (see
     :mod:`aftmesh.domain`).  `keep_vertices` keeps a dict's segments unsplit (the CDT

@@ -4,8 +4,12 @@ from __future__ import annotations
 
 from os import PathLike
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .errors import InvalidInputError
+
+if TYPE_CHECKING:
+    import shapely
 
 __all__ = ["read_geojson", "read_wkt"]
 
@@ -26,7 +30,7 @@ def _checked_geometry(geom, path: Path, what: str):
     return geom
 
 
-def read_wkt(path: PathArg):
+def read_wkt(path: PathArg) -> shapely.Geometry:
     """Read a shapely geometry from a file holding one WKT string.
 
     Examples
@@ -49,7 +53,7 @@ def read_wkt(path: PathArg):
     return _checked_geometry(geom, path, "WKT")
 
 
-def read_geojson(path: PathArg):
+def read_geojson(path: PathArg) -> shapely.Geometry:
     """Read a shapely geometry from a GeoJSON file.
 
     A ``Feature`` gives its geometry; a ``FeatureCollection`` a ``GeometryCollection``

@@ -27,11 +27,15 @@ from __future__ import annotations
 
 from os import PathLike
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .errors import InvalidInputError
 from .io_poly import write_mesh_poly, write_node_ele
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["LINE_FORMATS", "gmsh_physical_groups", "mesh_format", "write_mesh"]
 
@@ -92,7 +96,7 @@ def _add_group(names: dict, name: str, tag: int, dim: int) -> None:
     names[name] = np.array([tag, dim])
 
 
-def gmsh_physical_groups(mesh) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+def gmsh_physical_groups(mesh: Mesh) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
     """The Gmsh physical groups :func:`write_mesh` gives a mesh (see the module notes).
 
     Returns
@@ -179,7 +183,7 @@ def _cells_and_data(mesh, fmt: str):
     return cells, cell_data, field_data
 
 
-def write_mesh(mesh, path: PathArg, file_format: str | None = None) -> None:
+def write_mesh(mesh: Mesh, path: PathArg, file_format: str | None = None) -> None:
     """Write a mesh to a file (what :meth:`aftmesh.Mesh.write` does).
 
     Parameters

@@ -11,11 +11,16 @@ from __future__ import annotations
 
 from os import PathLike
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import InvalidInputError
 from .topology import hole_points, region_points
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["read_poly", "write_mesh_poly", "write_node_ele", "write_poly"]
 
@@ -298,7 +303,12 @@ def _as_array(value, name: str, columns: int | tuple, dtype) -> np.ndarray:
 
 
 def write_poly(
-    path: PathArg, vertices, segments, holes=None, regions=None, segment_markers=None
+    path: PathArg,
+    vertices: npt.ArrayLike,
+    segments: npt.ArrayLike,
+    holes: npt.ArrayLike | None = None,
+    regions: npt.ArrayLike | None = None,
+    segment_markers: npt.ArrayLike | None = None,
 ) -> None:
     """Write a planar straight-line graph as a Triangle ``.poly`` file.
 
@@ -366,7 +376,7 @@ def write_poly(
     Path(path).write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 
-def write_mesh_poly(mesh, path: Path) -> None:
+def write_mesh_poly(mesh: Mesh, path: Path) -> None:
     """A mesh as a ``.poly``: its points and segments with their markers, a point in
     each hole and, when the mesh has several regions, a regional attribute point in
     each piece enclosed by segments, so that meshing the file gives back the same
@@ -382,7 +392,7 @@ def write_mesh_poly(mesh, path: Path) -> None:
     )
 
 
-def write_node_ele(mesh, path: Path) -> None:
+def write_node_ele(mesh: Mesh, path: Path) -> None:
     """A mesh as Triangle's ``.node`` + ``.ele`` pair beside ``path``: vertex boundary
     markers 1 on the mesh boundary, each triangle's region as its attribute."""
     P, T = mesh.points, mesh.triangles

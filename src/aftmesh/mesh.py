@@ -4,12 +4,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._typing import PathArg, SizeFunction
 from .errors import InvalidOptionError
 from .quality import triangle_quality
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["Mesh", "triangle_quality"]
 
@@ -110,7 +114,7 @@ class Mesh:
         object.__setattr__(mesh, "info", arrays.get("info", {}))
         return mesh
 
-    def boundary_facets(self, tag) -> np.ndarray:
+    def boundary_facets(self, tag: str | int) -> np.ndarray:
         """Indices into ``segments`` of one tagged boundary part.
 
         Parameters
@@ -161,7 +165,7 @@ class Mesh:
         """Total area of the triangles."""
         return float(triangle_quality(self.points, self.triangles)["area"].sum())
 
-    def quality(self, size=None, bins: int = 10) -> dict[str, Any]:
+    def quality(self, size: float | SizeFunction | None = None, bins: int = 10) -> dict[str, Any]:
         """Summary of the triangles' shapes.
 
         Parameters
@@ -234,7 +238,7 @@ class Mesh:
             )
         return "\n".join(lines)
 
-    def write(self, path, file_format: str | None = None) -> None:
+    def write(self, path: PathArg, file_format: str | None = None) -> None:
         """Write the mesh to a file.
 
         ``.poly``, ``.node`` and ``.ele`` (Triangle's formats) are written natively: a
@@ -246,7 +250,13 @@ class Mesh:
 
         _io.write_mesh(self, Path(path), file_format)
 
-    def plot(self, ax=None, color_by: str = "quality", show_segments: bool = True, **kwargs):
+    def plot(
+        self,
+        ax: Axes | None = None,
+        color_by: str = "quality",
+        show_segments: bool = True,
+        **kwargs: Any,
+    ) -> Axes:
         """Draw the mesh with matplotlib (``pip install aftmesh[plot]``).
 
         Parameters

@@ -49,8 +49,14 @@ def snap_tolerance(pts: np.ndarray) -> float:
 
 
 def merge_and_node(
-    verts, segs, src, note, ring_source, tolerance: float = 0.0, report: dict | None = None
-):
+    verts: np.ndarray,
+    segs: np.ndarray,
+    src: np.ndarray,
+    note: list[str],
+    ring_source: np.ndarray | None,
+    tolerance: float = 0.0,
+    report: dict | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
     the outer ring, a T-junction between regions, a constraint line ending on a
@@ -77,7 +83,7 @@ def merge_and_node(
     return out
 
 
-def merge_close(verts: np.ndarray, tolerance: float):
+def merge_close(verts: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
     """Move every vertex within `tolerance` of another onto the first vertex (in
     input order: rings before lines before points) of its cluster; clusters are
     closed under that relation, so a chain of near vertices becomes one.  Returns the
@@ -104,7 +110,9 @@ def merge_close(verts: np.ndarray, tolerance: float):
     return out, int((out != verts).any(axis=1).sum())
 
 
-def merge_close_segments(pts, segs, src, note, tolerance: float):
+def merge_close_segments(
+    pts: np.ndarray, segs: np.ndarray, src: np.ndarray, note: list[str], tolerance: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
     """A dict's vertices merged within `tolerance` (see :func:`merge_close`), the
     segments renumbered, those that became points or repeats dropped.  Returns
     (vertices, segments, src, how many vertices moved)."""
@@ -123,7 +131,15 @@ def _crossing_pairs(verts, segs):
     return lines, pairs[:, pairs[0] < pairs[1]]
 
 
-def node_crossings(verts, segs, src, note, tol=None, rounds: int = NODING_ROUNDS, ring_source=None):
+def node_crossings(
+    verts: np.ndarray,
+    segs: np.ndarray,
+    src: np.ndarray,
+    note: list[str] | None,
+    tol: float | None = None,
+    rounds: int = NODING_ROUNDS,
+    ring_source: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Split the segments that cross each other at their crossing points, until none
     cross.  A crossing point is rounded, so it is not exactly on either segment, but
     within an ulp of both: the two pieces of each segment bend by that much at most,
@@ -201,8 +217,14 @@ def _drop_repeats(segs, src):
 
 
 def split_at_vertices(
-    pts, segs, src, note, tol: float = 0.0, ring_source=None, counts: dict | None = None
-):
+    pts: np.ndarray,
+    segs: np.ndarray,
+    src: np.ndarray,
+    note: list[str] | None,
+    tol: float = 0.0,
+    ring_source: np.ndarray | None = None,
+    counts: dict | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Split each segment at the vertices lying on its interior: exactly (decided with
     the exact orientation predicate), or, for a vertex on no polygon ring (a line's end
     or bend, a lone point), within `tol` of it (see snap_tolerance).  ring_source[s]
@@ -250,7 +272,7 @@ def split_at_vertices(
     return _cut(pts, segs, src, cuts)
 
 
-def refuse_crossings(pts, seg):
+def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
     """Dict / .poly input: segments crossing at a point inside both are refused (the
     policy of aftmesh.cdt), before any size-dependent splitting could hide them."""
     if len(seg) < 2:

@@ -6,6 +6,7 @@ any geometry is touched; the stages after this read a frozen :class:`Options`.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -72,7 +73,7 @@ class Options:
         return self.max_triangles, f"max_triangles={self.max_triangles}"
 
 
-def real(name: str, value, error=InvalidOptionError) -> float:
+def real(name: str, value: Any, error: type[ValueError] = InvalidOptionError) -> float:
     """A finite real number from an option value, or an error naming the option."""
     if isinstance(value, (bool, np.bool_)) or isinstance(value, (str, bytes)):
         raise error(f"{name} must be a number, got {value!r}")
@@ -101,7 +102,7 @@ def _check_max_triangles(max_triangles) -> int | None:
     return min(int(max_triangles), MAX_TRIANGLES)
 
 
-def _min_angle(value) -> float:
+def _min_angle(value: float | None) -> float:
     """The bound of the minimum-angle pass in degrees, 0 for none."""
     if value is None:
         return 0.0
@@ -117,21 +118,21 @@ def _min_angle(value) -> float:
 
 def check_options(
     *,
-    order,
-    max_triangles,
-    min_area,
-    greedy,
-    swaps,
-    split_boundary,
-    gradation,
-    close_factor,
-    smooth,
-    strategy,
-    progress,
-    repair=False,
-    tolerance=0.0,
-    boundary_tags=None,
-    min_angle=None,
+    order: str,
+    max_triangles: int | None,
+    min_area: float | None,
+    greedy: bool,
+    swaps: bool,
+    split_boundary: bool,
+    gradation: float,
+    close_factor: float,
+    smooth: int,
+    strategy: Strategy | None,
+    progress: bool | Callable[..., object] | None,
+    repair: bool = False,
+    tolerance: float = 0.0,
+    boundary_tags: Mapping[str, Any] | None = None,
+    min_angle: float | None = None,
 ) -> Options:
     """Validate generate's keyword options; return them as an :class:`Options`."""
     _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary, repair=repair))

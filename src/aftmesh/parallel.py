@@ -19,12 +19,16 @@ import itertools
 import os
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._typing import SizeArg
 from .errors import InvalidOptionError
 from .mesh import Mesh
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 __all__ = ["MeshingFailure", "generate_many", "imap_many"]
 
@@ -144,7 +148,7 @@ def _check(scheduler, errors, workers, chunksize, client):
         raise InvalidOptionError("client= needs scheduler='dask' (or the default)")
 
 
-def dask_client(client=None):
+def dask_client(client: Client | None = None) -> Client:
     """The given client, or the active ``dask.distributed`` client, or a clear error."""
     if client is not None:
         return client
@@ -241,11 +245,11 @@ def _refreeze(result):
 # ---------------------------------------------------------------- public API
 def imap_many(
     domains: Iterable,
-    size=None,
+    size: SizeArg = None,
     *,
     workers: int | None = None,
     scheduler: str = "threads",
-    client=None,
+    client: Client | None = None,
     errors: str = "raise",
     progress: Callable[[int, int | None], None] | None = None,
     chunksize: int | None = None,
@@ -302,11 +306,11 @@ def _length(domains) -> int | None:
 
 def generate_many(
     domains: Iterable,
-    size=None,
+    size: SizeArg = None,
     *,
     workers: int | None = None,
     scheduler: str = "threads",
-    client=None,
+    client: Client | None = None,
     errors: str = "raise",
     progress: Callable[[int, int | None], None] | None = None,
     chunksize: int | None = None,

@@ -25,13 +25,24 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, overload
 
 import numpy as np
 import shapely
 
+from ._typing import DomainArg, PathArg, SizeArg
 from .errors import CrossingSegmentsError, InvalidOptionError
 from .mesh import Mesh
 from .stitch import lawson_flips, stitch_parts
+
+if TYPE_CHECKING:
+    from distributed import Client
+
+    from .sizing import SizeField
+
+    # a box (xmin, ymin, xmax, ymax)
+    Box = tuple[float, float, float, float]
 
 __all__ = ["generate_partitioned"]
 
@@ -53,7 +64,7 @@ class Boundary:
     field: Callable  # the graded size field, callable f(x, y)
 
 
-def discretized_boundary(domain, size, options: dict) -> Boundary:
+def discretized_boundary(domain: DomainArg, size: SizeArg, options: dict) -> Boundary:
     """The boundary split by the size exactly as ``generate`` splits it, and the
     graded size field: a greedy run (no interior point) yields both."""
     from .generate import generate
@@ -74,7 +85,7 @@ def discretized_boundary(domain, size, options: dict) -> Boundary:
     )
 
 
-def split_by_size(p0: np.ndarray, p1: np.ndarray, field) -> np.ndarray:
+def split_by_size(p0: np.ndarray, p1: np.ndarray, field: SizeField) -> np.ndarray:
     """The points strictly between p0 and p1 that split the segment for the size,
     by the rule that splits the input edges."""
     from .boundary import discretize
@@ -135,7 +146,9 @@ def _bisect(box, xs, ys, w, k: int, insert, leaves: list) -> None:
     _bisect(second, xs, ys, w, k - k1, insert, leaves)
 
 
-def plan_cuts(b: Boundary, locate: _Locator, k: int, insert):
+def plan_cuts(
+    b: Boundary, locate: _Locator, k: int, insert: Callable[[int, float, Box], float]
+) -> list[Box]:
     """Bisect the domain's box into k leaf boxes, laying each cut by ``insert``."""
     lo, hi = b.points.min(axis=0), b.points.max(axis=0)
     g = (np.arange(SAMPLES) + 0.5) / SAMPLES
@@ -259,7 +272,9 @@ def _face_owners(C: Mesh, face, n_faces, leaves, locate):
     return probes, owner, inside, label
 
 
-def part_inputs(C: Mesh, leaves, locate) -> tuple[list[dict], list[np.ndarray]]:
+def part_inputs(
+    C: Mesh, leaves: list[Box], locate: _Locator
+) -> tuple[list[dict], list[np.ndarray]]:
     """One Triangle-style dict per non-empty part: its vertices and segments, a
     region point per face it meshes, a hole point per other face it encloses; and
     the coarse ids of each part's vertices."""
@@ -348,16 +363,42 @@ def _cut_pslg(b: Boundary, k: int):
     return pts, seg, leaves, locate
 
 
+@overload
 def generate_partitioned(
-    domain,
-    size=None,
+    domain: DomainArg,
+    size: SizeArg = None,
     *,
     partitions: int,
-    client=None,
+    client: Client | None = None,
     workers: int | None = None,
-    out=None,
+    out: None = None,
     options: dict | None = None,
-):
+) -> Mesh: ...
+
+
+@overload
+def generate_partitioned(
+    domain: DomainArg,
+    size: SizeArg = None,
+    *,
+    partitions: int,
+    client: Client | None = None,
+    workers: int | None = None,
+    out: PathArg,
+    options: dict | None = None,
+) -> Path: ...
+
+
+def generate_partitioned(
+    domain: DomainArg,
+    size: SizeArg = None,
+    *,
+    partitions: int,
+    client: Client | None = None,
+    workers: int | None = None,
+    out: PathArg | None = None,
+    options: dict | None = None,
+) -> Mesh | Path:
     """``aftmesh.generate(domain, size, partitions=k, client=..., out=...)``: see the
     module documentation.  ``options`` are generate's other keyword options.  With
     ``out`` (a directory) the parts are written there by the workers that mesh them

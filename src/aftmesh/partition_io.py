@@ -17,12 +17,18 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import os
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from ._typing import PathArg
 from .pvtu import write_index, write_part
 from .stitch import _void
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["write_parts"]
 
@@ -67,7 +73,7 @@ def _write(mesh, part: dict, meta: dict, offset: int, path: str) -> tuple:
     return mesh.n_points, mesh.n_triangles
 
 
-def part_meta(C, used: list, input_xy: np.ndarray, input_markers: np.ndarray) -> list[dict]:
+def part_meta(C: Mesh, used: list, input_xy: np.ndarray, input_markers: np.ndarray) -> list[dict]:
     """Per part: the global (coarse) ids of its vertices and the keys of the input
     pieces (not the cut pieces) with their markers."""
     n = len(C.points)
@@ -92,7 +98,16 @@ def part_meta(C, used: list, input_xy: np.ndarray, input_markers: np.ndarray) ->
     ]
 
 
-def write_parts(out, parts, metas, field, options, mesh_part, client, workers) -> Path:
+def write_parts(
+    out: PathArg,
+    parts: list[dict],
+    metas: list[dict],
+    field: Callable[..., Any],  # the graded size field f(x, y)
+    options: dict,
+    mesh_part: Callable[..., Mesh],
+    client: Any,  # a distributed.Client or None (Any: its branch reuses `meshes`)
+    workers: int | None,
+) -> Path:
     """Mesh and write every part; return the ``.pvtu`` path."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

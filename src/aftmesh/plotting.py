@@ -6,11 +6,19 @@ matplotlib is imported inside the functions, so ``import aftmesh`` never needs i
 from __future__ import annotations
 
 from os import PathLike
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from .errors import InvalidOptionError
 from .quality import triangle_quality
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.colors import Colormap
+    from matplotlib.typing import ColorType
+
+    from .mesh import Mesh
 
 __all__ = ["plot_mesh", "save_png"]
 
@@ -27,20 +35,20 @@ def _import_matplotlib(what: str):
 
 
 def plot_mesh(
-    mesh,
-    ax=None,
+    mesh: Mesh,
+    ax: Axes | None = None,
     color_by: str = "quality",
     show_segments: bool = True,
     *,
-    cmap=None,
-    edge_color="0.2",
+    cmap: str | Colormap | None = None,
+    edge_color: ColorType = "0.2",
     edge_width: float | None = None,
-    segment_color="k",
+    segment_color: ColorType = "k",
     segment_width: float = 1.5,
     colorbar: bool = True,
     title: str | bool = True,
-    **kwargs,
-):
+    **kwargs: Any,
+) -> Axes:
     """Draw a mesh: filled triangles, thin edges, the segments thicker.
 
     Parameters
@@ -101,7 +109,9 @@ def plot_mesh(
         edge_width = float(np.clip(12.0 / np.sqrt(max(len(T), 1)), 0.05, 0.6))
     q = triangle_quality(P, T) if len(T) else None
     if len(T):
-        edge_style = dict(edgecolors=edge_color if edge_width > 0 else "none", linewidth=edge_width)
+        edge_style: dict[str, Any] = dict(
+            edgecolors=edge_color if edge_width > 0 else "none", linewidth=edge_width
+        )
         if color_by == "quality":
             assert q is not None
             art = ax.tripcolor(
@@ -173,7 +183,13 @@ def plot_mesh(
 
 
 def save_png(
-    mesh, path: str | PathLike, *, dpi: int = 150, figsize=None, zoom=None, **kwargs
+    mesh: Mesh,
+    path: str | PathLike,
+    *,
+    dpi: int = 150,
+    figsize: tuple[float, float] | None = None,
+    zoom: tuple[float, float, float, float] | None = None,
+    **kwargs: Any,
 ) -> None:
     """Draw a mesh with :func:`plot_mesh` into a PNG file.
 

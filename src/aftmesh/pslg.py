@@ -18,6 +18,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from . import _kernel
 from ._order import brio_order
@@ -40,7 +41,7 @@ class BuiltCDT:
     n_split: int = 0  # segments that ran exactly through another vertex
 
 
-def as_points(value, name: str) -> np.ndarray:
+def as_points(value: npt.ArrayLike | None, name: str) -> np.ndarray:
     """An (n, 2) float64 array of finite coordinates, or an error naming the bad row."""
     try:
         arr = np.asarray(value, dtype=np.float64)
@@ -78,7 +79,7 @@ def check_range(arr: np.ndarray, name: str) -> None:
         )
 
 
-def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
+def as_segments(value: npt.ArrayLike | None, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
     if value is None:
         return np.zeros((0, 2), dtype=np.int32)
     try:
@@ -112,10 +113,10 @@ def as_segments(value, n_vertices: int, vertices: np.ndarray) -> np.ndarray:
 
 
 def build_cdt(
-    vertices,
-    segments=None,
-    holes=None,
-    regions=None,
+    vertices: npt.ArrayLike,
+    segments: npt.ArrayLike | None = None,
+    holes: npt.ArrayLike | None = None,
+    regions: npt.ArrayLike | None = None,
     *,
     carve: bool | None = None,
     nt_hint: int = 0,

@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import base64
 import xml.etree.ElementTree as ET
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
+from ._typing import PathArg
 from .errors import InvalidInputError
 from .mesh import Mesh
 
@@ -45,7 +47,15 @@ def _data_array(parent, name: str, arr: np.ndarray, components: int = 1) -> None
     node.text = base64.b64encode(np.uint64(len(raw)).tobytes() + raw).decode("ascii")
 
 
-def write_part(path, points, global_ids, triangles, regions, segments, markers) -> None:
+def write_part(
+    path: PathArg,
+    points: np.ndarray,
+    global_ids: np.ndarray,
+    triangles: np.ndarray,
+    regions: np.ndarray,
+    segments: np.ndarray,
+    markers: np.ndarray,
+) -> None:
     """One part as a ``.vtu`` file (see the module documentation)."""
     n_t, n_s = len(triangles), len(segments)
     root = ET.Element(
@@ -86,7 +96,7 @@ def write_part(path, points, global_ids, triangles, regions, segments, markers) 
     ET.ElementTree(root).write(path, xml_declaration=True, encoding="utf-8")
 
 
-def write_index(path, pieces) -> None:
+def write_index(path: PathArg, pieces: Sequence[str]) -> None:
     """The ``.pvtu`` file naming the parts (file names relative to it)."""
     root = ET.Element(
         "VTKFile",
@@ -128,7 +138,7 @@ def _arrays(path: Path) -> dict:
     return out
 
 
-def read_partitioned(path) -> Mesh:
+def read_partitioned(path: PathArg) -> Mesh:
     """Read a mesh written by ``aftmesh.generate(..., partitions=k, out=dir)``.
 
     Parameters
@@ -147,7 +157,7 @@ def read_partitioned(path) -> Mesh:
         if len(found) != 1:
             raise InvalidInputError(f"{path} holds {len(found)} .pvtu files, expected one")
         path = found[0]
-    parts = [_arrays(path.parent / p.get("Source")) for p in ET.parse(path).getroot().iter("Piece")]
+    parts = [_arrays(path.parent / p.get("Source")) for p in ET.parse(path).getroot().iter("Piece")]  # type: ignore[operator]
     n = 1 + max(int(a["GlobalPointId"].max()) for a in parts)
     points = np.zeros((n, 2))
     tris, regions, segs, markers = [], [], [], []

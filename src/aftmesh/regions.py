@@ -7,6 +7,7 @@ meshed).  A piece is classified by one point strictly inside one of its triangle
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from fractions import Fraction
 
 import numpy as np
@@ -17,7 +18,9 @@ from ._kernel import py_orient2d
 __all__ = ["classify_pieces"]
 
 
-def classify_pieces(polygons, probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
+def classify_pieces(
+    polygons: Sequence[shapely.Polygon], probes: np.ndarray, corners: np.ndarray
+) -> np.ndarray:
     """The index of the polygon each piece of the CDT lies in (-1: none), from a point
     inside one of its triangles (see Triangulation.components).  The probe is that
     triangle's rounded centroid; for a triangle an ulp or two wide it may fall on an

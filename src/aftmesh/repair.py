@@ -13,6 +13,7 @@ import numpy as np
 import shapely
 from shapely.geometry import GeometryCollection, MultiPolygon, Polygon
 
+from ._typing import DomainArg
 from .errors import InvalidDomainError
 from .validity import validity_reason
 
@@ -77,7 +78,7 @@ def _repair_collection(domain, report: dict):
     )
 
 
-def repair_domain(domain, is_ring: bool):
+def repair_domain(domain: DomainArg, is_ring: bool) -> tuple[DomainArg, dict]:
     """(repaired domain, report) for shapely input, an (n, 2) ring or a sequence of
     polygons; other forms (dict, ``.poly``) are returned as they are with an empty
     report: their segments are not polygons to repair."""

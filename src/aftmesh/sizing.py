@@ -12,12 +12,18 @@ never grows faster than ``gradation`` per unit of length relative to itself
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ._kernel import limit_gradation_grid
+from ._typing import Point2, SizeFunction
 from .errors import InvalidSizeError
+
+if TYPE_CHECKING:
+    import shapely
 
 __all__ = ["SizeField", "make_size_field"]
 
@@ -136,7 +142,7 @@ def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
     return h
 
 
-def per_region_size(polygons, sizes):
+def per_region_size(polygons: Sequence[shapely.Polygon], sizes: Iterable[float]) -> SizeFunction:
     """A size callable from one size per region: each region's own value inside it,
     the largest value outside all of them (the gradation limit then blends the values
     across interfaces, from the smaller side)."""
@@ -200,7 +206,11 @@ def _grid(bounds, spacing: float):
 
 
 def make_size_field(
-    size, bounds, boundary_points=None, boundary_lengths=None, gradation: float = DEFAULT_GRADATION
+    size: float | SizeFunction | None,
+    bounds: tuple[Point2, Point2],
+    boundary_points: np.ndarray | None = None,
+    boundary_lengths: Any = None,  # (n,) floats or None (Any: None is tested by a flag)
+    gradation: float = DEFAULT_GRADATION,
 ) -> SizeField:
     """Turn a size specification into a :class:`SizeField` over ``bounds``.
 

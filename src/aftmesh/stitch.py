@@ -11,10 +11,16 @@ the whole mesh the CDT of its vertices and the input segments again.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from . import _kernel
 from .errors import KernelError
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["lawson_flips", "stitch_parts"]
 
@@ -31,7 +37,7 @@ def _pair_keys(a, b, n: int) -> np.ndarray:
     return lo * n + hi
 
 
-def global_numbering(meshes):
+def global_numbering(meshes: Sequence[Mesh]) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
     """(points, per-part old -> new vertex maps, shared keys sorted): shared vertices
     (segment ends) first, numbered by their coordinates, then each part's others."""
     ends = [np.unique(m.segments) for m in meshes]
@@ -54,7 +60,19 @@ def global_numbering(meshes):
     return np.concatenate(points), maps, shared_keys
 
 
-def stitch_parts(meshes, input_xy: np.ndarray, input_markers: np.ndarray):
+def stitch_parts(
+    meshes: Sequence[Mesh], input_xy: np.ndarray, input_markers: np.ndarray
+) -> tuple[
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    np.ndarray,
+    set[Any],
+]:
     """One mesh from the part meshes: (points, triangles, neighbors, regions,
     segments, segment_markers, cut_edges, cut_vertices, constrained) where the
     segments are the input pieces (given as coordinate pairs ``input_xy`` (s, 2, 2)),

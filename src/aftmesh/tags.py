@@ -15,9 +15,11 @@ input edge it lies on, so a side split into many pieces keeps its name.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from .errors import InvalidOptionError
 
@@ -67,7 +69,11 @@ def _select(name: str, selector, mids: np.ndarray) -> np.ndarray:
     return picked
 
 
-def resolve_boundary_tags(boundary_tags, edge_midpoints, describe=None):
+def resolve_boundary_tags(
+    boundary_tags: Mapping[str, Any],
+    edge_midpoints: npt.ArrayLike,
+    describe: Callable[[int], str] | None = None,
+) -> tuple[np.ndarray, dict[str, int]]:
     """(tag of each input edge (e,) int32, {name: tag}) from a boundary_tags mapping.
 
     ``describe(e)``, if given, names input edge e in messages.  An edge picked

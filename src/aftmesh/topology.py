@@ -7,12 +7,17 @@ is a different job: it labels the pieces of the CDT before meshing.)
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from .mesh import Mesh
 
 __all__ = ["components", "hole_points", "region_points", "triangle_components"]
 
 
-def components(n: int, a, b) -> np.ndarray:
+def components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Label of each of ``n`` items joined by the pairs ``(a[i], b[i])``.
 
     The label of an item is the smallest item of its connected component.
@@ -61,7 +66,7 @@ def _is_segment(mesh, u: np.ndarray, w: np.ndarray) -> np.ndarray:
     return np.isin(np.minimum(u, w) * n + np.maximum(u, w), seg_key)
 
 
-def triangle_components(mesh, *, cut_at_segments: bool = False) -> np.ndarray:
+def triangle_components(mesh: Mesh, *, cut_at_segments: bool = False) -> np.ndarray:
     """The connected component of each triangle, through shared edges.
 
     Parameters
@@ -92,7 +97,7 @@ def triangle_components(mesh, *, cut_at_segments: bool = False) -> np.ndarray:
     return np.unique(labels, return_inverse=True)[1].reshape(-1)
 
 
-def hole_points(mesh) -> np.ndarray:
+def hole_points(mesh: Mesh) -> np.ndarray:
     """(h, 2): a point inside each hole of the mesh.
 
     The boundary edges are polygonized; each face they enclose is either covered by
@@ -126,7 +131,7 @@ def hole_points(mesh) -> np.ndarray:
     return np.array(holes).reshape(-1, 2)
 
 
-def region_points(mesh) -> np.ndarray:
+def region_points(mesh: Mesh) -> np.ndarray:
     """(r, 3) rows of (x, y, region): a point in each piece of the mesh enclosed by
     segments, with that piece's region (the centroid of its first triangle).
 

@@ -9,6 +9,7 @@ user can find it without a GIS at hand.
 from __future__ import annotations
 
 import re
+from collections.abc import Sequence
 
 import numpy as np
 import shapely
@@ -26,7 +27,7 @@ def _xy(x, y) -> str:
     return f"({float(x)!r}, {float(y)!r})"
 
 
-def validity_reason(geom) -> str:
+def validity_reason(geom: shapely.Geometry) -> str:
     """shapely's validity reason, with its location written as (x, y)."""
     reason = shapely.is_valid_reason(geom)
     return _WHERE.sub(lambda m: " at " + _xy(m.group(1), m.group(2)), reason)
@@ -128,7 +129,13 @@ def _leaves_at(line, union) -> np.ndarray:
     return best if best is not None else shapely.get_coordinates(line)[0]
 
 
-def check_lines_inside(polygons, lines, line_names, points, tolerance: float = 0.0) -> None:
+def check_lines_inside(
+    polygons: Sequence[Polygon],
+    lines: Sequence[shapely.LineString],
+    line_names: Sequence[str],
+    points: Sequence[shapely.Point],
+    tolerance: float = 0.0,
+) -> None:
     """Refuse constraint lines or fixed points outside the domain (a line may stick
     out by rounding only, see :func:`_outside_by_rounding`, or by `tolerance`)."""
     union = shapely.union_all(polygons)
