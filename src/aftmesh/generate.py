@@ -21,9 +21,10 @@ from .sizing import DEFAULT_GRADATION
 
 __all__ = ["generate"]
 
-# generate's options that a partitioned run passes on (partition.py decides which
-# reach the parts and which only the run that discretizes the whole boundary)
-_FORWARD = (
+# generate's keyword options checked by options.check_options; a partitioned run passes
+# them on (partition.py decides which reach the parts and which only the run that
+# discretizes the whole boundary)
+_OPTIONS = (
     "max_triangles",
     "min_area",
     "order",
@@ -256,32 +257,16 @@ def generate(
     >>> abs(mesh.area() - domain.area) < 1e-9
     True
     """
+    options = {k: v for k, v in locals().items() if k in _OPTIONS}
     if partitions is not None or client is not None or out is not None:
         from .partition import generate_partitioned
 
-        options = {k: v for k, v in locals().items() if k in _FORWARD}
         k = 1 if partitions is None else partitions
         return generate_partitioned(
             domain, size, partitions=k, client=client, out=out, options=options
         )
     t_start = time.perf_counter()
-    opts = check_options(
-        order=order,
-        max_triangles=max_triangles,
-        min_area=min_area,
-        greedy=greedy,
-        swaps=swaps,
-        split_boundary=split_boundary,
-        gradation=gradation,
-        close_factor=close_factor,
-        smooth=smooth,
-        strategy=strategy,
-        progress=progress,
-        repair=repair,
-        tolerance=tolerance,
-        boundary_tags=boundary_tags,
-        min_angle=min_angle,
-    )
+    opts = check_options(**options)
     dom = to_domain(
         domain, keep_vertices=not opts.split_boundary, tolerance=opts.tolerance, repair=opts.repair
     )
