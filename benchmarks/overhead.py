@@ -139,8 +139,15 @@ def real_outlines() -> list[Outline]:
     if files:
         return [_from_file(f) for f in files]
     cases = []
-    for n, tris in ((50, 100), (200, 500), (1000, 2000), (1000, 20000), (5000, 10000),
-                    (20000, 50000), (50000, 100000)):
+    for n, tris in (
+        (50, 100),
+        (200, 500),
+        (1000, 2000),
+        (1000, 20000),
+        (5000, 10000),
+        (20000, 50000),
+        (50000, 100000),
+    ):
         cases.append(_sized(f"star-{n}-{tris}", star(n, seed=n), tris))
         ring = coastline(n, seed=n)
         if _valid(ring):
@@ -170,8 +177,12 @@ def _time(fn: Callable[[], object], calls: int) -> dict:
         fn()
         cpu.append(time.process_time() - c0)
         wall.append(time.perf_counter() - w0)
-    return {"wall_med": statistics.median(wall), "wall_min": min(wall),
-            "cpu_med": statistics.median(cpu), "cpu_min": min(cpu)}
+    return {
+        "wall_med": statistics.median(wall),
+        "wall_min": min(wall),
+        "cpu_med": statistics.median(cpu),
+        "cpu_min": min(cpu),
+    }
 
 
 def _calls_for(seconds: float, budget: float, lo: int = 3, hi: int = OVERHEAD_CALLS) -> int:
@@ -186,8 +197,10 @@ def _runners(case: Outline):
     poly = case.polygon
     tri_dict = case.triangle_dict()
     switches = "pq30" + triangle_area_switch(EQUILATERAL * case.size**2)
-    return (lambda: aftmesh.generate(poly, case.size),
-            lambda: triangle.triangulate(tri_dict, switches))
+    return (
+        lambda: aftmesh.generate(poly, case.size),
+        lambda: triangle.triangulate(tri_dict, switches),
+    )
 
 
 def _group(filename: str, name: str) -> str:
@@ -233,17 +246,23 @@ def run_overhead(calls: int) -> None:
     case = overhead_outline()
     aft, tri = _runners(case)
     mesh = aft()
-    print(f"fixed cost: {case.name}, {len(case.ring)} vertices, size {case.size:.4g}, "
-          f"{len(mesh.triangles)} triangles (Triangle: {len(tri()['triangles'])})")
+    print(
+        f"fixed cost: {case.name}, {len(case.ring)} vertices, size {case.size:.4g}, "
+        f"{len(mesh.triangles)} triangles (Triangle: {len(tri()['triangles'])})"
+    )
     ta, tt = _time(aft, calls), _time(tri, calls)
     print(f"{'ms per call':<16}{'wall med':>9}{'wall min':>9}{'cpu med':>9}{'cpu min':>9}")
     for label, t in (("aftmesh", ta), ("Triangle pq30a", tt)):
-        print(f"{label:<16}{_ms(t['wall_med'])} {_ms(t['wall_min'])} "
-              f"{_ms(t['cpu_med'])} {_ms(t['cpu_min'])}")
+        print(
+            f"{label:<16}{_ms(t['wall_med'])} {_ms(t['wall_min'])} "
+            f"{_ms(t['cpu_med'])} {_ms(t['cpu_min'])}"
+        )
     print(f"ratio (cpu med): {ta['cpu_med'] / tt['cpu_med']:.1f}x")
     timing = [aftmesh.generate(case.polygon, case.size).info["timing"] for _ in range(calls)]
-    print("info['timing'] medians (ms): " + ", ".join(
-        f"{k} {1e3 * statistics.median(t[k] for t in timing):.3f}" for k in timing[0]))
+    print(
+        "info['timing'] medians (ms): "
+        + ", ".join(f"{k} {1e3 * statistics.median(t[k] for t in timing):.3f}" for k in timing[0])
+    )
     _print_profile(*profile(aft, calls))
 
 
@@ -269,12 +288,21 @@ def run_real(budget: float, breakdown: bool) -> None:
         once = time.process_time() - t0
         calls = _calls_for(once, budget)
         ta, tt = _time(aft, calls)["cpu_med"], _time(tri, calls)["cpu_med"]
-        line = (f"{case.name:<22}{len(case.ring):>7}{len(mesh.triangles):>8}"
-                f"{1e3 * ta:9.2f}{1e3 * tt:9.2f}{ta / tt:7.2f}")
+        line = (
+            f"{case.name:<22}{len(case.ring):>7}{len(mesh.triangles):>8}"
+            f"{1e3 * ta:9.2f}{1e3 * tt:9.2f}{ta / tt:7.2f}"
+        )
         if breakdown:
             stages, _ = profile(aft, max(1, calls // 3))
-            keep = ("to_domain", "size_field", "boundary_cdt", "prepare_front", "run_front",
-                    "smooth", "assemble")
+            keep = (
+                "to_domain",
+                "size_field",
+                "boundary_cdt",
+                "prepare_front",
+                "run_front",
+                "smooth",
+                "assemble",
+            )
             line += "  " + " ".join(f"{1e3 * stages[k]:.2f}" for k in keep)
         print(line, flush=True)
         rows.append(ta / tt)
@@ -284,12 +312,17 @@ def run_real(budget: float, breakdown: bool) -> None:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.overhead", description=__doc__)
     parser.add_argument("--real", action="store_true", help='the "small and real" group')
-    parser.add_argument("--calls", type=int, default=OVERHEAD_CALLS,
-                        help="calls timed for the fixed cost")
-    parser.add_argument("--budget", type=float, default=1.0,
-                        help="seconds of aftmesh time per real case and timing")
-    parser.add_argument("--no-breakdown", action="store_true",
-                        help="real group: skip the profiled per-stage breakdown")
+    parser.add_argument(
+        "--calls", type=int, default=OVERHEAD_CALLS, help="calls timed for the fixed cost"
+    )
+    parser.add_argument(
+        "--budget", type=float, default=1.0, help="seconds of aftmesh time per real case and timing"
+    )
+    parser.add_argument(
+        "--no-breakdown",
+        action="store_true",
+        help="real group: skip the profiled per-stage breakdown",
+    )
     args = parser.parse_args(argv)
     if args.real:
         run_real(args.budget, not args.no_breakdown)
