@@ -49,7 +49,14 @@ def snap_tolerance(pts: np.ndarray) -> float:
 
 
 def merge_and_node(
-    verts, segs, src, note, ring_source, tolerance: float = 0.0, report: dict | None = None
+    verts,
+    segs,
+    src,
+    note,
+    ring_source,
+    tolerance: float = 0.0,
+    report: dict | None = None,
+    valid_rings: int = 0,
 ):
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
@@ -59,7 +66,13 @@ def merge_and_node(
 
     With `tolerance` > 0, vertices closer than that are merged first (see
     :func:`merge_close`) and a line's free end or bend that near a segment splits it
-    there; ``report`` then receives the counts ``merged`` and ``snapped``."""
+    there; ``report`` then receives the counts ``merged`` and ``snapped``.
+
+    `valid_rings` > 0 says the segments are exactly the rings of one polygon that
+    shapely found valid, that many rings: then no two segments cross (validity
+    forbids it, decided with exact predicates as the crossing search would), so the
+    search is skipped; with one ring, no vertex lies on another segment either (the
+    ring is simple, and a ring's vertex is never snapped), so the split is skipped."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
@@ -69,9 +82,13 @@ def merge_and_node(
     segs = inverse.reshape(-1)[segs]
     tol = max(snap_tolerance(uniq), tolerance)
     counts = {"snapped": 0}
-    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
+    if valid_rings != 1 or tolerance > 0:
+        segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
+    if valid_rings and not tolerance > 0:
+        out = uniq, segs, src
+    else:
+        out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
     if report is not None and tolerance > 0:
         report.update(merged=n_merged, snapped=counts["snapped"])
     return out
