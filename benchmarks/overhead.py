@@ -41,6 +41,13 @@ STAR_ROUGHNESS = 0.3
 # of the vertex spacing (chosen so that size 1 gives ~200 triangles).
 STRIP_WIDTH = 1.5
 STRIP_JITTER = 0.2
+# The star polygons' radii: a wave of this amplitude, and noise of at most this many
+# vertex spacings (besides STAR_ROUGHNESS).
+STAR_WAVE = 0.2
+STAR_SPIKE = 3.0
+# Jitter of the star polygons' angles, in units of their mean spacing (uniform random
+# angles would give edges many orders of magnitude apart, which no real outline has).
+STAR_JITTER = 0.4
 # Midpoint displacement of the fractal coastlines, as a fraction of the edge length.
 COAST_DISPLACEMENT = 0.25
 # Area of an equilateral triangle of side h, over h^2: turns a triangle count into
@@ -80,10 +87,14 @@ class Outline:
 
 
 def star(n: int, seed: int) -> np.ndarray:
-    """A star-shaped ring of n vertices around the origin, radii 1 +- roughness."""
+    """A star-shaped ring of n vertices around the origin: a wavy disk (radius
+    1 +- STAR_WAVE) with random noise of at most STAR_ROUGHNESS or a few vertex
+    spacings on the radii, so that spikes stay as blunt as on real outlines."""
     rng = np.random.default_rng(seed)
-    angle = np.sort(rng.uniform(0, 2 * np.pi, n))
-    radius = 1.0 + STAR_ROUGHNESS * rng.uniform(-1, 1, n)
+    angle = (np.arange(n) + STAR_JITTER * rng.uniform(-1, 1, n)) * (2 * np.pi / n)
+    noise = min(STAR_ROUGHNESS, STAR_SPIKE * 2 * np.pi / n)
+    wave = STAR_WAVE * np.sin(3 * angle + rng.uniform(0, 2 * np.pi))
+    radius = 1.0 + wave + noise * rng.uniform(-1, 1, n)
     return np.c_[radius * np.cos(angle), radius * np.sin(angle)]
 
 
