@@ -290,17 +290,21 @@ def _print_profile(stages: dict, groups: dict) -> None:
 
 def run_real(budget: float, breakdown: bool) -> None:
     rows = []
-    header = f"{'case':<22}{'verts':>7}{'tris':>8}{'aft ms':>9}{'tri ms':>9}{'ratio':>7}"
+    header = (
+        f"{'case':<22}{'verts':>7}{'aft tri':>8}{'Tri tri':>8}{'aft ms':>9}{'tri ms':>9}"
+        f"{'ratio':>7}"
+    )
     print(header + ("  stages ms: domain size bdry prep front smooth asm" if breakdown else ""))
     for case in real_outlines():
         aft, tri = _runners(case)
         t0 = time.process_time()
         mesh = aft()
         once = time.process_time() - t0
+        n_tri = len(tri()["triangles"])
         calls = _calls_for(once, budget)
         ta, tt = _time(aft, calls)["cpu_med"], _time(tri, calls)["cpu_med"]
         line = (
-            f"{case.name:<22}{len(case.ring):>7}{len(mesh.triangles):>8}"
+            f"{case.name:<22}{len(case.ring):>7}{len(mesh.triangles):>8}{n_tri:>8}"
             f"{1e3 * ta:9.2f}{1e3 * tt:9.2f}{ta / tt:7.2f}"
         )
         if breakdown:
