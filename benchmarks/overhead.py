@@ -66,24 +66,62 @@ STAGES = (
     ("assemble", "_stages.py", "assemble"),
 )
 REALWORLD = Path(__file__).parent / "data" / "realworld"
+# An outline file without a size is meshed at its bounding-box diagonal over this.
+REAL_DIVISIONS = 100
 
 
 @dataclass
 class Outline:
     name: str
-    ring: np.ndarray  # (n, 2), not closed
+    ring: np.ndarray  # (n, 2), not closed; empty when `geometry` is given
     size: float
+    geometry: object = None  # a shapely polygon or multipolygon instead of the ring
 
     @property
     def polygon(self):
         from shapely.geometry import Polygon
 
-        return Polygon(self.ring)
+        return self.geometry if self.geometry is not None else Polygon(self.ring)
+
+    @property
+    def n_vertices(self) -> int:
+        import shapely
+
+        if self.geometry is None:
+            return len(self.ring)
+        return (
+            len(shapely.get_coordinates(self.geometry))
+            - shapely.get_num_geometries(shapely.get_rings(self.geometry)).sum()
+        )
 
     def triangle_dict(self) -> dict:
+        if self.geometry is not None:
+            return _pslg(self.geometry)
         n = len(self.ring)
         idx = np.arange(n)
         return {"vertices": self.ring, "segments": np.c_[idx, (idx + 1) % n]}
+
+
+def _pslg(geom) -> dict:
+    """Triangle's input for a polygonal geometry: its noded boundary's vertices and
+    segments, and a point in each hole."""
+    import shapely
+
+    lines = shapely.get_parts(shapely.node(geom.boundary))
+    coords, which = shapely.get_coordinates(lines, return_index=True)
+    verts, inverse = np.unique(coords, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    same = which[:-1] == which[1:]
+    segs = np.c_[inverse[:-1][same], inverse[1:][same]]
+    segs = np.unique(np.sort(segs[segs[:, 0] != segs[:, 1]], axis=1), axis=0)
+    edges = shapely.linestrings(np.stack([verts[segs[:, 0]], verts[segs[:, 1]]], axis=1))
+    faces = shapely.get_parts(shapely.polygonize(edges))
+    probes = shapely.point_on_surface(faces)
+    holes = shapely.get_coordinates(probes[~shapely.covers(geom, probes)])
+    out = {"vertices": verts, "segments": segs.astype(np.int32)}
+    if len(holes):
+        out["holes"] = holes
+    return out
 
 
 def star(n: int, seed: int) -> np.ndarray:
@@ -144,9 +182,9 @@ def overhead_outline() -> Outline:
     return Outline("strip-100", strip(OVERHEAD_VERTICES, seed=1, width=STRIP_WIDTH), 1.0)
 
 
-def real_outlines() -> list[Outline]:
+def real_outlines(folder: Path = REALWORLD) -> list[Outline]:
     """The "small and real" group: files under data/realworld if any, else made."""
-    files = sorted(REALWORLD.glob("*.json")) if REALWORLD.is_dir() else []
+    files = sorted(folder.glob("*.json")) if folder.is_dir() else []
     if files:
         return [_from_file(f) for f in files]
     cases = []
@@ -167,14 +205,23 @@ def real_outlines() -> list[Outline]:
 
 
 def _from_file(path: Path) -> Outline:
+    """An outline file: ``domain_wkb`` (a valid geometry, hex WKB) or ``ring``; the
+    size is ``size`` if given, else the bounding-box diagonal / 100."""
     data = json.loads(path.read_text())
-    ring = np.asarray(data["ring"] if "ring" in data else data["vertices"], dtype=np.float64)
+    if "domain_wkb" in data:
+        import shapely
+
+        geom = shapely.orient_polygons(shapely.from_wkb(bytes.fromhex(data["domain_wkb"])))
+        x0, y0, x1, y1 = geom.bounds
+        size = data.get("size") or math.hypot(x1 - x0, y1 - y0) / REAL_DIVISIONS
+        return Outline(path.stem, np.zeros((0, 2)), float(size), geom)
+    ring = np.asarray(data["ring"], dtype=np.float64)
     if (ring[0] == ring[-1]).all():
         ring = ring[:-1]
     size = data.get("size")
     if size is None:
         lo, hi = ring.min(axis=0), ring.max(axis=0)
-        size = float(np.hypot(*(hi - lo))) / 100
+        size = float(np.hypot(*(hi - lo))) / REAL_DIVISIONS
     return Outline(path.stem, ring, float(size))
 
 
@@ -258,7 +305,7 @@ def run_overhead(calls: int) -> None:
     aft, tri = _runners(case)
     mesh = aft()
     print(
-        f"fixed cost: {case.name}, {len(case.ring)} vertices, size {case.size:.4g}, "
+        f"fixed cost: {case.name}, {case.n_vertices} vertices, size {case.size:.4g}, "
         f"{len(mesh.triangles)} triangles (Triangle: {len(tri()['triangles'])})"
     )
     ta, tt = _time(aft, calls), _time(tri, calls)
@@ -288,14 +335,14 @@ def _print_profile(stages: dict, groups: dict) -> None:
             print(f"  {group:<24}{_ms(t)}  {100 * t / total:4.0f} %")
 
 
-def run_real(budget: float, breakdown: bool) -> None:
+def run_real(budget: float, breakdown: bool, folder: Path = REALWORLD) -> None:
     rows = []
     header = (
         f"{'case':<22}{'verts':>7}{'aft tri':>8}{'Tri tri':>8}{'aft ms':>9}{'tri ms':>9}"
         f"{'ratio':>7}"
     )
     print(header + ("  stages ms: domain size bdry prep front smooth asm" if breakdown else ""))
-    for case in real_outlines():
+    for case in real_outlines(folder):
         aft, tri = _runners(case)
         t0 = time.process_time()
         mesh = aft()
@@ -304,7 +351,7 @@ def run_real(budget: float, breakdown: bool) -> None:
         calls = _calls_for(once, budget)
         ta, tt = _time(aft, calls)["cpu_med"], _time(tri, calls)["cpu_med"]
         line = (
-            f"{case.name:<22}{len(case.ring):>7}{len(mesh.triangles):>8}{n_tri:>8}"
+            f"{case.name:<22}{case.n_vertices:>7}{len(mesh.triangles):>8}{n_tri:>8}"
             f"{1e3 * ta:9.2f}{1e3 * tt:9.2f}{ta / tt:7.2f}"
         )
         if breakdown:
@@ -338,9 +385,12 @@ def main(argv=None) -> None:
         action="store_true",
         help="real group: skip the profiled per-stage breakdown",
     )
+    parser.add_argument(
+        "--data", type=Path, default=REALWORLD, help="folder of outline .json files (--real)"
+    )
     args = parser.parse_args(argv)
     if args.real:
-        run_real(args.budget, not args.no_breakdown)
+        run_real(args.budget, not args.no_breakdown, args.data)
     else:
         run_overhead(args.calls)
 
