@@ -19,6 +19,9 @@ _SAMPLES = 32
 # Below this relative difference of h between two samples, 1/h is integrated as the
 # mean of the ends (the exact log formula would divide by nearly zero).
 _FLAT = 1e-9
+# Split points interpolated at once, times the samples per segment: bounds the
+# temporary arrays of _interp_rows (a few megabytes).
+INTERP_CHUNK = 1 << 20
 
 
 def discretize(
@@ -73,40 +76,78 @@ def discretize(
         )
     pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
     split = np.flatnonzero(pieces > 1)
-    points = []
-    for k in split:
-        n = int(pieces[k])
-        targets = cum[k, -1] * np.arange(1, n) / n
-        t = np.interp(targets, cum[k], s)
-        points.append(a[k] + np.outer(t, b[k] - a[k]))
-    if clear > 0 and points:
+    counts = pieces[split] - 1  # split points of each split segment
+    row = np.repeat(split, counts)  # the segment of each split point
+    step = np.arange(len(row)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
+    targets = cum[row, -1] * step / pieces[row]
+    t = _interp_rows(targets, cum, row, s)
+    pts = a[row] + t[:, None] * (b - a)[row]
+    if clear > 0 and len(split):
+        points = np.split(pts, np.cumsum(counts)[:-1])
         points = _clear_of_others(points, split, a, b, clear)
         points = _keep_sides(points, split, vertices, segments, clear)
-    new_vertices = [vertices]
-    new_segments = []
-    new_source = []
-    next_index = len(vertices)
-    simple = pieces == 1
-    new_segments.append(segments[simple])
-    new_source.append(source[simple])
-    for k, pts in zip(split, points):
-        # rounded points never coincide at the sizes make_size_field accepts, but a
-        # piece of zero length would be fatal: drop any that do
-        prev = np.vstack([a[k], pts[:-1]])
-        distinct = (pts != prev).any(axis=1) & (pts != b[k]).any(axis=1)
-        if not distinct.all():
-            pts = pts[distinct]
-        m = len(pts)
-        idx = np.arange(next_index, next_index + m)
-        next_index += m
-        chain = np.concatenate([[segments[k, 0]], idx, [segments[k, 1]]])
-        new_vertices.append(pts)
-        new_segments.append(np.c_[chain[:-1], chain[1:]])
-        new_source.append(np.full(m + 1, source[k]))
+        counts = np.array([len(p) for p in points], dtype=np.int64)
+        row = np.repeat(split, counts)
+        pts = np.concatenate(points) if len(points) else pts
+    return _chains(vertices, segments, source, pieces == 1, split, row, counts, pts, a, b)
+
+
+def _interp_rows(x: np.ndarray, cum: np.ndarray, row: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """``np.interp(x[i], cum[row[i]], s)`` for every i at once, with the same
+    arithmetic as numpy's (so the same roundings): the interval found by the last
+    sample <= x, a sample hit exactly or the last one returned as is, otherwise
+    slope * (x - left) + s[left], from the other end if that is NaN."""
+    out = np.empty(len(x))
+    chunk = max(1, INTERP_CHUNK // cum.shape[1])
+    last = cum.shape[1] - 1
+    for lo in range(0, len(x), chunk):
+        xs, rows = x[lo : lo + chunk], row[lo : lo + chunk]
+        c = cum[rows]
+        j = np.clip((c <= xs[:, None]).sum(axis=1) - 1, 0, last)
+        j1 = np.minimum(j + 1, last)
+        left, right = c[np.arange(len(xs)), j], c[np.arange(len(xs)), j1]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            slope = (s[j1] - s[j]) / (right - left)
+            val = slope * (xs - left) + s[j]
+            nan = np.isnan(val)
+            if nan.any():
+                other = slope * (xs - right) + s[j1]
+                val = np.where(nan, np.where(np.isnan(other) & (s[j] == s[j1]), s[j], other), val)
+        exact = (j == last) | (left == xs)
+        out[lo : lo + chunk] = np.where(exact, s[j], val)
+    return out
+
+
+def _chains(vertices, segments, source, simple, split, row, counts, pts, a, b):
+    """The new (vertices, segments, source): the unsplit segments first, then each
+    split segment as the chain through its split points, in order."""
+    # rounded points never coincide at the sizes make_size_field accepts, but a
+    # piece of zero length would be fatal: drop any that do
+    first = np.zeros(len(row), dtype=bool)
+    starts = np.cumsum(counts) - counts
+    first[starts[counts > 0]] = True
+    prev = np.where(first[:, None], a[row], np.roll(pts, 1, axis=0))
+    distinct = (pts != prev).any(axis=1) & (pts != b[row]).any(axis=1)
+    if not distinct.all():
+        pts, row = pts[distinct], row[distinct]
+        counts = np.bincount(np.searchsorted(split, row), minlength=len(split))
+    # each chain: the segment's start, its split points, its end
+    size = counts + 2
+    chain = np.empty(int(size.sum()), dtype=np.int64)
+    begin = np.cumsum(size) - size
+    chain[begin] = segments[split, 0]
+    chain[begin + size - 1] = segments[split, 1]
+    inner = np.ones(len(chain), dtype=bool)
+    inner[begin] = False
+    inner[begin + size - 1] = False
+    chain[inner] = len(vertices) + np.arange(len(pts))
+    link = np.ones(len(chain) - 1, dtype=bool) if len(chain) else np.zeros(0, dtype=bool)
+    link[(begin + size - 1)[:-1]] = False  # no piece from one chain's end to the next
+    body = np.flatnonzero(link)
     return (
-        np.concatenate(new_vertices),
-        np.concatenate(new_segments).astype(np.int32),
-        np.concatenate(new_source).astype(np.int32),
+        np.concatenate([vertices, pts]),
+        np.concatenate([segments[simple], np.c_[chain[body], chain[body + 1]]]).astype(np.int32),
+        np.concatenate([source[simple], np.repeat(source[split], counts + 1)]).astype(np.int32),
     )
 
 

@@ -156,8 +156,10 @@ def _from_shapely(
     points: list,
     names: list[str],
     tolerance: float = 0.0,
+    valid: bool = False,
 ) -> Domain:
-    """Rings of the polygons, constraint lines and fixed points -> a noded Domain."""
+    """Rings of the polygons, constraint lines and fixed points -> a noded Domain.
+    `valid`: the one polygon is known valid (so its rings cannot cross)."""
     note: list[str] = []
     chains = _Chains()
     for k, poly in enumerate(polygons):
@@ -181,7 +183,12 @@ def _from_shapely(
     ).astype(np.int32)
     is_ring = np.asarray(chains.is_ring, dtype=bool)[edge_source]
     report: dict = {}
-    verts, segs, edges = merge_and_node(verts, segs, edges, note, is_ring, tolerance, report)
+    valid_rings = 0
+    if valid and len(polygons) == 1 and not lines and not points:
+        valid_rings = len(chains.names)
+    verts, segs, edges = merge_and_node(
+        verts, segs, edges, note, is_ring, tolerance, report, valid_rings
+    )
     union_area = float(shapely.union_all(polygons).area)
     mids = np.concatenate(chains.midpoints) if chains.midpoints else np.zeros((0, 2))
     return Domain(
@@ -322,10 +329,14 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     for k, p in enumerate(polygons):
         check_polygon(p, names[k])
     check_lines_inside(polygons, lines, line_names, points, tolerance)
+    checked = polygons[0] if len(polygons) == 1 else None
     single = shapely.union_all(polygons)
     if isinstance(single, Polygon):
         polygons, names = [single], ["the polygon"]
-    return _from_shapely(polygons, lines, line_names, points, names, tolerance)
+    # the union of one polygon is that polygon, vertex for vertex, in practice: then
+    # check_polygon's validity holds for what is meshed
+    valid = checked is not None and bool(shapely.equals_exact(polygons[0], checked, 0.0))
+    return _from_shapely(polygons, lines, line_names, points, names, tolerance, valid)
 
 
 def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:
@@ -341,7 +352,7 @@ def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:
     except (ValueError, TypeError) as exc:
         raise InvalidDomainError(f"the ring is not a polygon: {exc}") from None
     check_polygon(poly, "the polygon")
-    return _from_shapely([poly], [], [], [], ["the polygon"], tolerance)
+    return _from_shapely([poly], [], [], [], ["the polygon"], tolerance, valid=True)
 
 
 def _region_polygon(k: int, item):

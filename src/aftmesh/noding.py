@@ -32,6 +32,11 @@ NODING_ROUNDS = 8
 # point-on-line test may miss a point exactly on a segment but not representable on
 # its line, so candidates are gathered this near and then decided exactly.
 CANDIDATE_REACH = 1e-12
+# Relative error bound of a floating-point orientation of double inputs: Shewchuk's
+# (3 + 16 eps) eps for the first stage, taken four times over for margin.
+ORIENT_ERROR = 4 * (3 + 16 * 2.0**-53) * 2.0**-53
+# Below this the orientation's terms may have lost precision by underflow.
+ORIENT_TINY = 1e-280
 
 
 def snap_tolerance(pts: np.ndarray) -> float:
@@ -56,6 +61,7 @@ def merge_and_node(
     ring_source: np.ndarray | None,
     tolerance: float = 0.0,
     report: dict | None = None,
+    valid_rings: int = 0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
@@ -65,7 +71,13 @@ def merge_and_node(
 
     With `tolerance` > 0, vertices closer than that are merged first (see
     :func:`merge_close`) and a line's free end or bend that near a segment splits it
-    there; ``report`` then receives the counts ``merged`` and ``snapped``."""
+    there; ``report`` then receives the counts ``merged`` and ``snapped``.
+
+    `valid_rings` > 0 says the segments are exactly the rings of one polygon that
+    shapely found valid, that many rings: then no two segments cross (validity
+    forbids it, decided with exact predicates as the crossing search would), so the
+    search is skipped; with one ring, no vertex lies on another segment either (the
+    ring is simple, and a ring's vertex is never snapped), so the split is skipped."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
@@ -75,9 +87,13 @@ def merge_and_node(
     segs = inverse.reshape(-1)[segs]
     tol = max(snap_tolerance(uniq), tolerance)
     counts = {"snapped": 0}
-    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
+    if valid_rings != 1 or tolerance > 0:
+        segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
+    if valid_rings and not tolerance > 0:
+        out = uniq, segs, src
+    else:
+        out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
     if report is not None and tolerance > 0:
         report.update(merged=n_merged, snapped=counts["snapped"])
     return out
@@ -126,9 +142,41 @@ def merge_close_segments(
 
 
 def _crossing_pairs(verts, segs):
+    """The pairs (i < j) of segments that cross, in the order of shapely's STRtree
+    query with the "crosses" predicate.  That predicate is slow (a full relate per
+    pair), so it is asked only of the box-overlapping pairs that might cross: not of
+    pairs sharing a vertex (two segments from one point meet only there, or overlap
+    along a line: neither is a crossing), nor of pairs where one segment's ends are
+    certainly on the same side of the other's line (see _same_side)."""
     lines = shapely.linestrings(np.stack([verts[segs[:, 0]], verts[segs[:, 1]]], axis=1))
-    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
-    return lines, pairs[:, pairs[0] < pairs[1]]
+    pairs = shapely.STRtree(lines).query(lines)  # box overlaps, in the tree's order
+    pairs = pairs[:, pairs[0] < pairs[1]]
+    si, sj = segs[pairs[0]], segs[pairs[1]]
+    shared = (si[:, :1] == sj).any(axis=1) | (si[:, 1:] == sj).any(axis=1)
+    a, b, c, d = verts[si[:, 0]], verts[si[:, 1]], verts[sj[:, 0]], verts[sj[:, 1]]
+    maybe = ~shared & ~_same_side(a, b, c, d) & ~_same_side(c, d, a, b)
+    pairs = pairs[:, maybe]
+    return lines, pairs[:, shapely.crosses(lines[pairs[0]], lines[pairs[1]])]
+
+
+def _same_side(a, b, c, d) -> np.ndarray:
+    """Whether c and d are certainly strictly on the same side of line a-b: both
+    floating-point orientations are beyond a bound on their rounding error (a few
+    times Shewchuk's first-stage bound), so any exact predicate agrees."""
+    ab = b - a
+
+    def orient(p):
+        left = ab[:, 0] * (p[:, 1] - a[:, 1])
+        right = ab[:, 1] * (p[:, 0] - a[:, 0])
+        det = left - right
+        sure = np.abs(det) > ORIENT_ERROR * (np.abs(left) + np.abs(right))
+        # a bound relative to the terms means nothing once they underflow
+        sure &= np.abs(left) + np.abs(right) > ORIENT_TINY
+        return np.where(sure, np.sign(det), 0.0)
+
+    with np.errstate(over="ignore", invalid="ignore"):
+        oc, od = orient(c), orient(d)
+    return oc * od > 0
 
 
 def node_crossings(

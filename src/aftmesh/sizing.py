@@ -189,7 +189,8 @@ def limit_gradation(h: np.ndarray, dx: float, dy: float, gradation: float) -> np
     return out
 
 
-def _grid(bounds, spacing: float):
+def _nodes(bounds, spacing: float):
+    """The grid's origin, spacings and node coordinates along x and along y."""
     (xmin, ymin), (xmax, ymax) = bounds
     span = max(xmax - xmin, ymax - ymin)
     spacing = max(spacing, span / (MAX_GRID - 1))
@@ -201,8 +202,14 @@ def _grid(bounds, spacing: float):
     dy = (ymax - ymin) / (ny - 1) if ymax > ymin else 1.0
     xs = xmin + dx * np.arange(nx)
     ys = ymin + dy * np.arange(ny)
+    return xmin, ymin, dx, dy, xs, ys
+
+
+def _grid(bounds, spacing: float):
+    """As :func:`_nodes`, with the nodes' coordinates as two full 2-D arrays."""
+    x0, y0, dx, dy, xs, ys = _nodes(bounds, spacing)
     X, Y = np.meshgrid(xs, ys)
-    return xmin, ymin, dx, dy, X, Y
+    return x0, y0, dx, dy, X, Y
 
 
 def make_size_field(
@@ -268,14 +275,16 @@ def make_size_field(
         h0 = _evaluate(size, X, Y)
         _check_resolution(h0, X, Y, bounds, "the size callable gave")
         spacing = min(spacing, NODES_PER_SIZE * float(h0.min()))
-    x0, y0, dx, dy, X, Y = _grid(bounds, spacing)
+    # the full 2-D node coordinates only for a callable: elsewhere node (j, i) is
+    # read as (xs[i], ys[j]), the same numbers without two grid-sized arrays
+    x0, y0, dx, dy, xs, ys = _nodes(bounds, spacing)
+    shape = (len(ys), len(xs))
     if callable(size):
+        X, Y = np.meshgrid(xs, ys)
         h = _evaluate(size, X, Y)
         _check_resolution(h, X, Y, bounds, "the size callable gave")
-    elif constant is not None:
-        h = np.full(X.shape, constant)
     else:
-        h = np.full(X.shape, np.inf)
+        h = np.full(shape, np.inf if constant is None else constant)
     # the growth rate used to spread the boundary's sizes: the user's gradation, or
     # the default one if the user asked for none (size=None with gradation=1 would
     # otherwise leave the field infinite away from the boundary)
@@ -291,17 +300,20 @@ def make_size_field(
         # field would then be larger than the boundary's edges right next to them,
         # and the first layer of triangles on a graded boundary would be stretched)
         rate = spread - 1.0
-        i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, X.shape[1] - 2)
-        j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, X.shape[0] - 2)
+        i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, shape[1] - 2)
+        j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, shape[0] - 2)
         for di in (0, 1):
             for dj in (0, 1):
-                dist = np.hypot(X[j + dj, i + di] - pts[:, 0], Y[j + dj, i + di] - pts[:, 1])
+                dist = np.hypot(xs[i + di] - pts[:, 0], ys[j + dj] - pts[:, 1])
                 np.minimum.at(
                     h,
                     (j + dj, i + di),
                     lengths + rate * np.maximum(0.0, dist - BOUNDARY_REACH * lengths),
                 )
-    h = limit_gradation(h, dx, dy, spread if not np.isfinite(h).all() else gradation)
+    limit = spread if not np.isfinite(h).all() else gradation
+    if limit > 1.0 and h.size > 1:
+        # as limit_gradation, in place: h is this function's own C-ordered array
+        limit_gradation_grid(h, float(dx), float(dy), float(limit - 1.0))
     if not np.isfinite(h).all():
         raise InvalidSizeError("could not derive a size from the boundary")
     return SizeField(float(x0), float(y0), float(dx), float(dy), np.ascontiguousarray(h))
