@@ -13,7 +13,6 @@ constraint lines' edges in order; for a dict or ``.poly`` file, the index in its
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from os import PathLike
 
 import numpy as np
@@ -28,10 +27,12 @@ from shapely.geometry import (
     Polygon,
 )
 
-from ._typing import DomainArg, PathArg
-from .errors import InvalidDomainError, InvalidInputError
-from .noding import merge_and_node, merge_close_segments, refuse_crossings, split_at_vertices
-from .pslg import as_points, as_segments, check_range
+from ._typing import DomainArg
+from .domain_record import Domain
+from .errors import InvalidDomainError
+from .noding import merge_and_node
+from .pslg import check_range
+from .pslg_input import from_dict, from_poly_file
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
 
@@ -40,39 +41,6 @@ __all__ = ["Domain", "to_domain"]
 # Two regions overlap when their common area exceeds this fraction of the smaller
 # one: below it the overlap is the rounding of a shared boundary, not a real overlap.
 REGION_OVERLAP = 1e-12
-
-
-@dataclass
-class Domain:
-    """A PSLG plus what is needed to mesh it.
-
-    ``segment_edge[k]`` is the input edge segment k is a piece of (see the module
-    doc); ``edge_source[e]`` the input ring / constraint line / segment edge e belongs
-    to (``source_names`` says which; ``source_markers``, if the input had them, maps
-    that number to the user's own segment marker); ``edge_is_ring[e]`` whether edge e
-    is on a polygon ring.  ``polygons`` classify the pieces cut out by the segments
-    into regions (index in the list; outside all: not meshed).  Dict and ``.poly``
-    inputs instead carry Triangle's ``holes`` and ``region_points``."""
-
-    vertices: np.ndarray
-    segments: np.ndarray
-    segment_edge: np.ndarray
-    edge_source: np.ndarray
-    source_names: list[str]
-    edge_is_ring: np.ndarray | None = None
-    polygons: list | None = None
-    holes: np.ndarray | None = None
-    region_points: np.ndarray | None = None
-    area: float | None = None
-    cleanup: list[str] = field(default_factory=list)
-    source_markers: np.ndarray | None = None  # the user's marker of each source
-    edge_midpoints: np.ndarray | None = None  # (e, 2) the midpoint of each input edge
-    report: dict = field(default_factory=dict)  # what repair / tolerance changed
-
-    @property
-    def segment_source(self) -> np.ndarray:
-        """The input ring / line / segment each segment comes from."""
-        return self.edge_source[self.segment_edge]
 
 
 class _Chains:
@@ -204,94 +172,6 @@ def _from_shapely(
         edge_midpoints=mids,
         report={"tolerance": report} if report else {},
     )
-
-
-def _dict_regions(regions):
-    if regions is None:
-        return None
-    try:
-        reg = np.asarray(regions, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(
-            f"regions must be rows of (x, y, marker[, max_area]): {exc}"
-        ) from None
-    if reg.size == 0:
-        return None
-    if reg.ndim != 2 or reg.shape[1] < 3:
-        raise InvalidInputError(f"regions must have shape (r, 3) or (r, 4), got {reg.shape}")
-    return reg[:, :3]
-
-
-def _dict_markers(markers, n_segments: int):
-    if markers is None:
-        return None
-    try:
-        markers = np.asarray(markers).reshape(-1)
-    except (ValueError, TypeError) as exc:
-        raise InvalidInputError(f"segment_markers must be a list of integers: {exc}") from None
-    if len(markers) != n_segments:
-        raise InvalidInputError(
-            f"segment_markers has {len(markers)} entries for {n_segments} segments"
-        )
-    if not np.issubdtype(markers.dtype, np.integer):
-        raise InvalidInputError("segment_markers must be integers")
-    big = np.abs(markers.astype(np.int64)) > 2**31 - 1
-    if big.any():
-        i = int(np.flatnonzero(big)[0])
-        raise InvalidInputError(
-            f"segment_markers[{i}] = {int(markers[i])} is out of the int32 range"
-        )
-    return markers.astype(np.int32)
-
-
-def from_dict(d: dict, presplit: bool = True, tolerance: float = 0.0) -> Domain:
-    """A Triangle-style dict (``vertices``, ``segments``, ``holes``, ``regions``,
-    ``segment_markers``): crossings refused, as :func:`aftmesh.cdt` does."""
-    if "vertices" not in d:
-        raise InvalidInputError("a domain dict needs 'vertices' (and usually 'segments')")
-    pts = as_points(d["vertices"], "vertices")
-    seg = as_segments(d.get("segments"), len(pts), pts)
-    holes = as_points(d.get("holes", np.zeros((0, 2))), "holes")
-    reg = _dict_regions(d.get("regions"))
-    markers = _dict_markers(d.get("segment_markers"), len(seg))
-    names = [f"segments[{i}]" for i in range(len(seg))]
-    mids = 0.5 * (pts[seg[:, 0]] + pts[seg[:, 1]])
-    edges = np.arange(len(seg), dtype=np.int32)
-    note: list[str] = []
-    report = {"merged": 0, "snapped": 0}
-    if tolerance > 0:
-        pts, seg, edges, report["merged"] = merge_close_segments(pts, seg, edges, note, tolerance)
-    refuse_crossings(pts, seg)
-    # a segment running exactly through another vertex is split there now, before the
-    # size splits it into pieces whose rounded ends would miss that vertex (kept whole,
-    # the CDT splits it there exactly, at no cost here)
-    if presplit or tolerance > 0:
-        seg, edges = split_at_vertices(pts, seg, edges, note, tolerance, None, report)
-    return Domain(
-        pts,
-        np.asarray(seg, dtype=np.int32),
-        np.asarray(edges, dtype=np.int32),
-        np.arange(len(names), dtype=np.int32),
-        names,
-        holes=holes,
-        region_points=reg,
-        source_markers=markers,
-        cleanup=note,
-        edge_midpoints=mids,
-        report={"tolerance": report} if tolerance > 0 else {},
-    )
-
-
-def from_poly_file(path: PathArg, presplit: bool = True, tolerance: float = 0.0) -> Domain:
-    """A Triangle ``.poly`` file: read into a dict, then as :func:`from_dict`."""
-    from .io import read_poly
-
-    try:
-        d = read_poly(path)
-    except OSError as exc:
-        # a wrong path is the caller's input error like any other
-        raise InvalidInputError(f"cannot read the domain file {str(path)!r}: {exc}") from None
-    return from_dict(d, presplit, tolerance)
 
 
 def _split_geometry(domain):
