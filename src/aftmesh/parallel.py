@@ -32,6 +32,18 @@ if TYPE_CHECKING:
 
 __all__ = ["MeshingFailure", "generate_many", "imap_many"]
 
+# the Mesh arrays a pickled Mesh brings back writable (Mesh's own are read-only)
+_ARRAYS = (
+    "points",
+    "triangles",
+    "neighbors",
+    "segments",
+    "regions",
+    "segment_markers",
+    "segment_sources",
+    "segment_tags",
+)
+
 _SCHEDULERS = ("threads", "dask", "serial")
 _ERRORS = ("raise", "collect")
 # Tasks kept in flight per worker: enough that no worker waits for the driver to hand
@@ -235,7 +247,7 @@ def _dask(items, options, client, chunksize) -> Iterator[tuple[int, Any]]:
 def _refreeze(result):
     """A Mesh unpickled from a worker has writeable arrays: freeze them again."""
     if isinstance(result, Mesh):
-        for name in ("points", "triangles", "neighbors", "segments", "regions", "segment_markers"):
+        for name in _ARRAYS:
             arr = getattr(result, name)
             if arr is not None and arr.flags.writeable:
                 arr.setflags(write=False)
