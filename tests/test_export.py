@@ -276,11 +276,6 @@ def readme_example(marker: str) -> str:
     return found.group(1)
 
 
-@pytest.mark.xfail(
-    not hasattr(aftmesh.Mesh, "boundary_facets"),
-    strict=True,
-    reason="generate(boundary_tags=) and Mesh.boundary_facets come with branch py",
-)
 def test_readme_poisson_example_runs(tmp_path, monkeypatch, capsys):
     pytest.importorskip("skfem")
     pytest.importorskip("meshio")
