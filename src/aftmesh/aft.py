@@ -39,7 +39,8 @@ class Strategy:
         return kernel.get_next_edge()
 
     def compute_new_candidate(self, kernel: Triangulation, E: int) -> tuple[float, float, float]:
-        """A point R on the left of E, and the local target size h: (x, y, h)."""
+        """A point R on the left of E, and the length h the proximity rules measure
+        against (the local size, at most 1.5 times the side of T(E, R)): (x, y, h)."""
         return kernel.compute_new_candidate(E)
 
     def new_is_preferred(
