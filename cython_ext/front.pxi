@@ -39,10 +39,11 @@ cdef enum:
 # New_is_preferred's default: take S when |S - R| < DEFAULT_CLOSE_FACTOR * h
 cdef double DEFAULT_CLOSE_FACTOR = 0.5
 # is_crowded refuses R closer than EDGE_PROXIMITY * close_factor * h to a constrained
-# edge it faces: where two fronts are less than about 1.2 h apart, R would leave a gap
-# of a fraction of h that only slivers fill, so the front connects across instead.
-# 0.7 (it was 0.5) raised the real-world group's mean radius ratio; 0.85 took the
-# squares' minimum angle below 40 degrees.
+# edge it faces: where two fronts are closer than R's height (about 0.87 h) plus that,
+# about 1.2 h, R would leave a gap of a fraction of h that only slivers fill, so the
+# front connects across instead.
+# Raising it from 0.5 raised the real-world group's mean radius ratio (0.85 by most),
+# but from 0.7 on a single triangle of the squares fell below 40 degrees.
 cdef double EDGE_PROXIMITY = 0.65
 
 from cpython.ref cimport PyObject

@@ -160,7 +160,7 @@ def generate(
         Bound on how fast the size may grow, per unit of its own length (>= 1).
     close_factor : float
         New_is_preferred refuses R when S, or a vertex R would be joined to, is closer
-        than ``close_factor * h`` (a constrained edge it would face: 0.7 times that, so
+        than ``close_factor * h`` (a constrained edge it would face: 0.65 times that, so
         fronts closer than about 1.2 h connect across).  ``h`` is the local size, but
         at most 1.5 times the side of R's triangle where the size is well above the
         front edge (short input edges).
