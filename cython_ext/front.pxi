@@ -441,9 +441,9 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
     close_factor * h to a vertex it would be joined to, or closer than EDGE_PROXIMITY
     times that to a constrained edge it would face (the narrow-gap rule).  Those
     vertices and edges belong to R's insertion cavity (the unmeshed triangles whose
-    circumcircles contain R, reached without
-    crossing a constraint), because they become R's neighbours; only the part of the
-    cavity within close_factor * h of R can hold them, so the search stays there.
+    circumcircles contain R, reached without crossing a constraint), because they
+    become R's neighbours; only the part of the cavity within close_factor * h of R
+    can hold them, so the search stays there.
     Returns 1 (crowded), 0, or an error."""
     cdef int n = 0, i, k, e, t, u, j, x, y, z
     cdef double dv2 = (A.close_factor * h) * (A.close_factor * h)
