@@ -56,15 +56,12 @@ cdef int aft_init(Aft* A) noexcept nogil:
     A.lr_cap = LR_INITIAL_CAP
     A.left = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
     A.right = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
-    A.size.nx = 1
-    A.size.ny = 1
-    A.size.h = <double*> malloc(sizeof(double))
+    A.size.constant = 1.0
     A.max_triangles = -1
     A.close_factor = DEFAULT_CLOSE_FACTOR
     A.swaps = True
-    if A.heap == NULL or A.left == NULL or A.right == NULL or A.size.h == NULL:
+    if A.heap == NULL or A.left == NULL or A.right == NULL:
         return ERR_NOMEM
-    A.size.h[0] = 1.0
     return 0
 
 
@@ -72,7 +69,7 @@ cdef void aft_free(Aft* A) noexcept nogil:
     free(A.heap)
     free(A.left)
     free(A.right)
-    free(A.size.h)
+    size_field_free(&A.size)
     memset(A, 0, sizeof(Aft))
 
 
