@@ -73,9 +73,10 @@ def test_size_callable_of_the_wrong_shape_is_refused(result, shape):
 
 def test_size_callable_is_sampled_in_a_few_batched_calls():
     """The callable gets 1-D float64 arrays, a bounded number of times and points in
-    all (sizing.RESOLVE_ROUNDS, RESOLVE_EVALUATIONS), and the field asks for no more
-    than it gave at any of its samples."""
-    from aftmesh.sizing import RESOLVE_EVALUATIONS, RESOLVE_ROUNDS
+    all (sizing.RESOLVE_ROUNDS, RESOLVE_EVALUATIONS); the field asks for no more than
+    it gave at the background's vertices, and at the samples it did not keep, no more
+    than RESOLVE_TOLERANCE above it."""
+    from aftmesh.sizing import RESOLVE_EVALUATIONS, RESOLVE_ROUNDS, RESOLVE_TOLERANCE
 
     calls = []
 
@@ -90,4 +91,6 @@ def test_size_callable_is_sampled_in_a_few_batched_calls():
     assert sum(map(len, calls)) <= RESOLVE_EVALUATIONS + len(field.points)
     seen = np.concatenate(calls)
     asked = 0.05 + 0.05 * seen[:, 0] * seen[:, 1]
-    assert np.all(field(seen[:, 0], seen[:, 1]) <= asked * (1 + 1e-12))
+    assert np.all(field(seen[:, 0], seen[:, 1]) <= asked * (1 + RESOLVE_TOLERANCE))
+    p = field.points
+    assert np.all(field(p[:, 0], p[:, 1]) <= (0.05 + 0.05 * p[:, 0] * p[:, 1]) * (1 + 1e-12))

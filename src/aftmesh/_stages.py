@@ -213,7 +213,7 @@ def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) 
 
 def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Options):
     """Give the CDT's pieces their regions, check the domain has area and fits
-    max_triangles, and hand the size grid and options to the kernel."""
+    max_triangles, and hand the size field and options to the kernel."""
     kernel = boundary.built.kernel
     if dom.polygons is not None:
         comp, probes, corners = kernel.components()

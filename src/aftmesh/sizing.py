@@ -161,7 +161,7 @@ def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
 
 
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """The user's size at the grid nodes, in one call: ``size(x, y)`` with x and y
+    """The user's size at the points (x, y), in one call: ``size(x, y)`` with x and y
     1-D arrays of equal length (the nodes row by row), returning that many sizes or
     one number.  1-D because that is what point-based tools take (``np.c_[x, y]``,
     KD-trees, interpolators, ``shapely.distance`` of points)."""
