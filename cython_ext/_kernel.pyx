@@ -718,6 +718,8 @@ def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] 
     S.rate = rate
     S.reach = reach
     S.hint = 0
+    S.vhint = NULL
+    S.vhint_cap = 0
     S.nt = tv.shape[0]
     S.nv = xy.shape[0]
     if S.nt:

@@ -21,7 +21,7 @@
 # Uses: sizing.pxd (SizeField); nothing else of the kernel.
 
 from libc.math cimport sqrt, INFINITY, isinf
-from libc.stdlib cimport malloc, free
+from libc.stdlib cimport malloc, free, realloc
 from libc.string cimport memcpy
 from libc.stdint cimport int32_t
 from sizing cimport SizeField
@@ -33,9 +33,10 @@ cdef void size_field_free(SizeField* S) noexcept nogil:
     free(S.g)
     free(S.tv)
     free(S.nb)
+    free(S.vhint)
     S.xy = S.w = S.g = NULL
-    S.tv = S.nb = NULL
-    S.nv = S.nt = 0
+    S.tv = S.nb = S.vhint = NULL
+    S.nv = S.nt = S.vhint_cap = 0
     S.hint = 0
 
 
@@ -143,6 +144,32 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
                     if c < h:
                         h = c
                     break
+    return h
+
+
+cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil:
+    """size_at, with the walk started where the last look-up made from mesh vertex v
+    ended (a look-up near v: Compute_new_candidate's, at the middle of an edge of v).
+    The front jumps across the domain between steps, and the walk from the last
+    look-up anywhere would then cross the background."""
+    cdef int32_t* grown
+    cdef int cap, i
+    cdef double h
+    if S.nt == 0 or v < 0:
+        return size_at(S, x, y)
+    if v >= S.vhint_cap:
+        cap = 2 * v + 64
+        grown = <int32_t*> realloc(S.vhint, cap * sizeof(int32_t))
+        if grown == NULL:
+            return size_at(S, x, y)     # no cache: only the walks are longer
+        for i in range(S.vhint_cap, cap):
+            grown[i] = -1
+        S.vhint = grown
+        S.vhint_cap = cap
+    if S.vhint[v] >= 0:
+        S.hint = S.vhint[v]
+    h = size_at(S, x, y)
+    S.vhint[v] = S.hint
     return h
 
 
