@@ -186,6 +186,51 @@ cdef class Triangulation:
         _raise_for(&self.T, res)
         return merged_arr
 
+    def add_points(self, const double[:, ::1] points):
+        """Append points as new vertices and insert them into the triangulation (which
+        must have been started by insert_points).  Returns their vertex indices, or
+        the earlier vertex at exactly the same place."""
+        cdef int m = points.shape[0], i, v, res = 0
+        out_arr = np.empty(m, dtype=np.int32)
+        cdef int32_t[::1] out = out_arr
+        with nogil:
+            for i in range(m):
+                v = add_vertex(&self.T, points[i, 0], points[i, 1])
+                if v < 0:
+                    res = v
+                    break
+                res = insert_vertex(&self.T, v, NONE)
+                if res < 0:
+                    break
+                out[i] = res
+        _raise_for(&self.T, min(res, 0))
+        return out_arr
+
+    def finite_triangles(self):
+        """Every live finite triangle, whatever its state: (tv (t, 3) of kernel vertex
+        indices, counter-clockwise; nb (t, 3), the triangle across the edge opposite
+        vertex k, -1 at the hull)."""
+        cdef Tri* T = &self.T
+        cdef int t, k, n = 0, u
+        index_arr = np.full(T.nt, -1, dtype=np.int32)
+        cdef int32_t[::1] index = index_arr
+        for t in range(T.nt):
+            if T.tstate[t] != T_FREE and not is_ghost(T, t):
+                index[t] = n
+                n += 1
+        tv_arr = np.empty((n, 3), dtype=np.int32)
+        nb_arr = np.empty((n, 3), dtype=np.int32)
+        cdef int32_t[:, ::1] tv = tv_arr
+        cdef int32_t[:, ::1] nb = nb_arr
+        for t in range(T.nt):
+            if index[t] >= 0:
+                for k in range(3):
+                    tv[index[t], k] = T.tv[3 * t + k]
+                    # the edge opposite vertex k is half-edge 3t + k + 1
+                    u = index[T.twin[3 * t + (k + 1) % 3] // 3]
+                    nb[index[t], k] = u
+        return tv_arr, nb_arr
+
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
                         int first_id=0):
         """Insert constrained edges (pairs of vertex indices).  With flag E_SEGMENT,
@@ -396,26 +441,25 @@ cdef class Triangulation:
 
     # ------------------------------------------------------------ Basic_aft
 
-    def set_size_grid(self, double x0, double y0, double dx, double dy,
-                      const double[:, ::1] h):
-        """The size field: h[j, i] at (x0 + i dx, y0 + j dy), bilinear in between; a
-        1 x 1 array is a constant.  Values must be finite and positive (checked by the
-        Python layer)."""
-        cdef int ny = h.shape[0], nx = h.shape[1], i, j
-        cdef double* buf = <double*> malloc(nx * ny * sizeof(double))
-        if buf == NULL:
+    def set_size_field(self, double constant, const double[:, ::1] xy,
+                       const double[::1] w, const double[::1] g, const int32_t[:, ::1] tv,
+                       const int32_t[:, ::1] nb, double rate, double reach):
+        """The size field (sizing.pxi): a constant when tv has no rows, else sizes w
+        (interpolated) and g (cones of slope rate, flat to reach g) at the background
+        vertices xy, on
+        the triangles tv with neighbours nb.  The arrays are copied; the values must be
+        positive (inf in w: no user size), as the Python layer checks."""
+        cdef int nt = tv.shape[0], nv = xy.shape[0], res
+        if nt == 0:
+            res = size_field_set(&self.A.size, constant, 0, 0, NULL, NULL, NULL, NULL, NULL,
+                                 rate, reach)
+        else:
+            if w.shape[0] != nv or g.shape[0] != nv or nb.shape[0] != nt:
+                raise ValueError("size field arrays of mismatched lengths")
+            res = size_field_set(&self.A.size, constant, nv, nt, &xy[0, 0], &w[0], &g[0],
+                                 &tv[0, 0], &nb[0, 0], rate, reach)
+        if res:
             raise MemoryError()
-        for j in range(ny):
-            for i in range(nx):
-                buf[j * nx + i] = h[j, i]
-        free(self.A.size.h)
-        self.A.size.h = buf
-        self.A.size.nx = nx
-        self.A.size.ny = ny
-        self.A.size.x0 = x0
-        self.A.size.y0 = y0
-        self.A.size.dx = dx if dx > 0 else 1.0
-        self.A.size.dy = dy if dy > 0 else 1.0
 
     def size_at(self, double x, double y):
         return size_at(&self.A.size, x, y)
@@ -662,10 +706,71 @@ def incircle_many(const double[:, ::1] points, const int32_t[:, ::1] quad):
     return out_arr
 
 
-def limit_gradation_grid(double[:, ::1] h, double dx, double dy, double rate, int rounds=2):
-    """In place: lower h so that h[p] <= h[q] + rate * |p - q| between grid neighbours
-    (8-neighbour raster sweeps, forward then backward, `rounds` times), i.e. the size
-    grows by at most `rate` per unit of length along any path of grid nodes."""
-    if h.shape[0] and h.shape[1]:
-        with nogil:
-            limit_gradation(&h[0, 0], h.shape[1], h.shape[0], dx, dy, rate, rounds)
+def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] w,
+                    const double[::1] g, const int32_t[:, ::1] tv, const int32_t[:, ::1] nb,
+                    double rate, double reach, const double[::1] x, const double[::1] y):
+    """The size field of Triangulation.set_size_field at the points (x[i], y[i])."""
+    cdef SizeField S
+    cdef Py_ssize_t i, n = x.shape[0]
+    out_arr = np.empty(n, dtype=np.float64)
+    cdef double[::1] out = out_arr
+    S.constant = constant
+    S.rate = rate
+    S.reach = reach
+    S.hint = 0
+    S.vhint = NULL
+    S.vhint_cap = 0
+    S.nt = tv.shape[0]
+    S.nv = xy.shape[0]
+    if S.nt:
+        if w.shape[0] != S.nv or g.shape[0] != S.nv or nb.shape[0] != S.nt:
+            raise ValueError("size field arrays of mismatched lengths")
+        # read only: size_at writes nothing but the hint
+        S.xy = <double*> &xy[0, 0]
+        S.w = <double*> &w[0]
+        S.g = <double*> &g[0]
+        S.tv = <int32_t*> &tv[0, 0]
+        S.nb = <int32_t*> &nb[0, 0]
+    if y.shape[0] != n:
+        raise ValueError("x and y must have the same length")
+    with nogil:
+        for i in range(n):
+            out[i] = size_at(&S, x[i], y[i])
+    return out_arr
+
+
+def limit_gradation_mesh(const double[:, ::1] xy, const int32_t[:, ::1] tv, double[::1] h,
+                         double rate, double reach=0.0):
+    """In place: lower h (one value per row of xy) so that h[v] <= h[u] + rate
+    max(0, |uv| - reach h[u]) along every edge of the triangles tv: the size grows by
+    at most `rate` per unit of length along any path of edges (after holding for
+    reach times itself)."""
+    cdef int nv = xy.shape[0], nt = tv.shape[0], t, k, a, b, res
+    if h.shape[0] != nv:
+        raise ValueError("h must have one value per vertex")
+    if nt == 0 or nv == 0:
+        return
+    start_arr = np.zeros(nv + 1, dtype=np.int32)
+    adj_arr = np.empty(6 * nt, dtype=np.int32)
+    fill_arr = np.empty(nv, dtype=np.int32)
+    cdef int32_t[::1] start = start_arr
+    cdef int32_t[::1] adj = adj_arr
+    cdef int32_t[::1] fill = fill_arr
+    with nogil:
+        for t in range(nt):
+            for k in range(3):
+                start[tv[t, k] + 1] += 2
+        for a in range(nv):
+            start[a + 1] += start[a]
+            fill[a] = start[a]
+        for t in range(nt):
+            for k in range(3):
+                a = tv[t, k]
+                b = tv[t, (k + 1) % 3]
+                adj[fill[a]] = b
+                fill[a] += 1
+                adj[fill[b]] = a
+                fill[b] += 1
+        res = limit_gradation_graph(nv, &start[0], &adj[0], &xy[0, 0], &h[0], rate, reach)
+    if res:
+        raise MemoryError()

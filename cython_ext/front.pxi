@@ -63,15 +63,12 @@ cdef int aft_init(Aft* A) noexcept nogil:
     A.lr_cap = LR_INITIAL_CAP
     A.left = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
     A.right = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
-    A.size.nx = 1
-    A.size.ny = 1
-    A.size.h = <double*> malloc(sizeof(double))
+    A.size.constant = 1.0
     A.max_triangles = -1
     A.close_factor = DEFAULT_CLOSE_FACTOR
     A.swaps = True
-    if A.heap == NULL or A.left == NULL or A.right == NULL or A.size.h == NULL:
+    if A.heap == NULL or A.left == NULL or A.right == NULL:
         return ERR_NOMEM
-    A.size.h[0] = 1.0
     return 0
 
 
@@ -79,7 +76,7 @@ cdef void aft_free(Aft* A) noexcept nogil:
     free(A.heap)
     free(A.left)
     free(A.right)
-    free(A.size.h)
+    size_field_free(&A.size)
     memset(A, 0, sizeof(Aft))
 
 
@@ -225,7 +222,7 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
     cdef double ex = pb[0] - pa[0], ey = pb[1] - pa[1]
     cdef double L = sqrt(ex * ex + ey * ey)
-    cdef double h = size_at(&A.size, mx, my)
+    cdef double h = size_at_from(&A.size, mx, my, T.tv[e])
     cdef double d, height, nx, ny
     nx = -ey / L
     ny = ex / L

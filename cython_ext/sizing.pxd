@@ -1,7 +1,17 @@
 # The compiled size field's storage (routines in sizing.pxi).
+from libc.stdint cimport int32_t
 
 cdef struct SizeField:
-    double x0, y0       # lower-left grid node
-    double dx, dy       # node spacing
-    int nx, ny          # nodes per row / per column
-    double* h           # h[j * nx + i] at (x0 + i dx, y0 + j dy)
+    double constant     # the size everywhere when nt == 0
+    int32_t nv, nt      # background vertices and triangles (nt == 0: a constant)
+    double* xy          # 2 per background vertex
+    double* w           # the user's size at each vertex, gradation-limited (inf: none)
+    double* g           # the smallest size any source asks for there, gradation-limited
+    int32_t* tv         # 3 per background triangle, counter-clockwise
+    int32_t* nb         # 3 per triangle: the one across the edge opposite vertex k, -1 none
+    double rate         # a vertex's size g grows by at most this per unit of distance ...
+    double reach        # ... beyond this many times g from the vertex
+    int32_t hint        # the triangle the last look-up ended in: the next walk starts there
+    int32_t* vhint      # per mesh vertex: the background triangle of the last look-up
+    int32_t vhint_cap   # made from it (-1: none yet), so walks stay short when the
+                        # front jumps across the domain

@@ -1,78 +1,254 @@
 # The compiled size field: target edge length h(x, y) read by Compute_new_candidate.
 #
-# A background grid of nx * ny nodes over a rectangle, interpolated bilinearly and
-# clamped outside it; a 1 x 1 grid is a constant.  The Python layer fills the grid by
-# sampling the user's size (a number or a callable evaluated on whole arrays at once),
-# so the compiled loop never calls back into Python.
+# A constant, or sizes stored at the vertices of a background Delaunay triangulation
+# (the input vertices, the bounding box's corners, and points where a size callable
+# needed them: sizing.py builds it).  Its cost grows with the input, never with the
+# bounding box.  Inside the background triangle holding p,
+#
+#     h(p) = min( linear interpolation of w,  min over nearby vertices v of cone_v(p) ),
+#     cone_v(p) = g_v + rate max(0, |p - v| - reach g_v)
+#
+# w is the user's size (smooth, so linear interpolation follows it once the background
+# resolves it); g is what the boundary asks for (a short input edge's length at its
+# ends), which changes by orders of magnitude within one background triangle: the cones
+# cones give it the gradation limit exactly, where interpolating g would
+# spread a tiny size across the whole triangle.  (The size holds for reach g_v around
+# the vertex before it grows: the first layer of triangles on a boundary is then as
+# large as the boundary's edges, not larger.)  "Nearby" is the triangle's own three
+# vertices and the three across its edges.  Points outside the background read the
+# nearest point of the last triangle of the walk.
 #
 # Uses: sizing.pxd (SizeField); nothing else of the kernel.
 
-from libc.math cimport sqrt
+from libc.math cimport sqrt, INFINITY, isinf
+from libc.stdlib cimport malloc, free, realloc
+from libc.string cimport memcpy
+from libc.stdint cimport int32_t
 from sizing cimport SizeField
 
 
-cdef inline double size_at(const SizeField* S, double x, double y) noexcept nogil:
-    cdef double fx, fy, tx, ty
-    cdef int i, j
-    if S.nx == 1 and S.ny == 1:
-        return S.h[0]
-    fx = (x - S.x0) / S.dx if S.nx > 1 else 0.0
-    fy = (y - S.y0) / S.dy if S.ny > 1 else 0.0
-    if not fx > 0.0:        # also catches NaN
-        fx = 0.0
-    if not fy > 0.0:
-        fy = 0.0
-    if fx > S.nx - 1:
-        fx = S.nx - 1
-    if fy > S.ny - 1:
-        fy = S.ny - 1
-    i = <int> fx
-    j = <int> fy
-    if i > S.nx - 2:
-        i = S.nx - 2 if S.nx > 1 else 0
-    if j > S.ny - 2:
-        j = S.ny - 2 if S.ny > 1 else 0
-    tx = fx - i
-    ty = fy - j
-    if S.nx == 1:
-        return (1.0 - ty) * S.h[j] + ty * S.h[j + 1]
-    if S.ny == 1:
-        return (1.0 - tx) * S.h[i] + tx * S.h[i + 1]
-    return ((1.0 - ty) * ((1.0 - tx) * S.h[j * S.nx + i] + tx * S.h[j * S.nx + i + 1])
-            + ty * ((1.0 - tx) * S.h[(j + 1) * S.nx + i] + tx * S.h[(j + 1) * S.nx + i + 1]))
+cdef void size_field_free(SizeField* S) noexcept nogil:
+    free(S.xy)
+    free(S.w)
+    free(S.g)
+    free(S.tv)
+    free(S.nb)
+    free(S.vhint)
+    S.xy = S.w = S.g = NULL
+    S.tv = S.nb = S.vhint = NULL
+    S.nv = S.nt = S.vhint_cap = 0
+    S.hint = 0
 
 
-cdef void limit_gradation(double* h, Py_ssize_t nx, Py_ssize_t ny, double dx, double dy,
-                          double rate, int rounds) noexcept nogil:
-    """In place on the ny x nx grid h (row j at h + j nx): lower h so that h[p] <=
-    h[q] + rate |p - q| between 8-neighbours, by raster sweeps forward then backward,
-    `rounds` times: the size then grows by at most `rate` per unit of length along any
-    path of grid nodes (the gradation limit of src/aftmesh/sizing.py)."""
-    cdef Py_ssize_t i, j
-    cdef int r
-    cdef double cx = rate * dx, cy = rate * dy, cd = rate * sqrt(dx * dx + dy * dy), v
-    for r in range(rounds):
-        for j in range(ny):
-            for i in range(nx):
-                v = h[j * nx + i]
-                if i > 0:
-                    v = min(v, h[j * nx + i - 1] + cx)
-                if j > 0:
-                    v = min(v, h[(j - 1) * nx + i] + cy)
-                    if i > 0:
-                        v = min(v, h[(j - 1) * nx + i - 1] + cd)
-                    if i < nx - 1:
-                        v = min(v, h[(j - 1) * nx + i + 1] + cd)
-                h[j * nx + i] = v
-        for j in range(ny - 1, -1, -1):
-            for i in range(nx - 1, -1, -1):
-                v = h[j * nx + i]
-                if i < nx - 1:
-                    v = min(v, h[j * nx + i + 1] + cx)
-                if j < ny - 1:
-                    v = min(v, h[(j + 1) * nx + i] + cy)
-                    if i < nx - 1:
-                        v = min(v, h[(j + 1) * nx + i + 1] + cd)
-                    if i > 0:
-                        v = min(v, h[(j + 1) * nx + i - 1] + cd)
-                h[j * nx + i] = v
+cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const double* xy,
+                        const double* w, const double* g, const int32_t* tv,
+                        const int32_t* nb, double rate, double reach) noexcept nogil:
+    """Replace S by copies of the given arrays (nt == 0: the constant); 0 or ERR_NOMEM."""
+    size_field_free(S)
+    S.constant = constant
+    S.rate = rate
+    S.reach = reach
+    if nt == 0:
+        return 0
+    S.xy = <double*> malloc(2 * nv * sizeof(double))
+    S.w = <double*> malloc(nv * sizeof(double))
+    S.g = <double*> malloc(nv * sizeof(double))
+    S.tv = <int32_t*> malloc(3 * nt * sizeof(int32_t))
+    S.nb = <int32_t*> malloc(3 * nt * sizeof(int32_t))
+    if S.xy == NULL or S.w == NULL or S.g == NULL or S.tv == NULL or S.nb == NULL:
+        size_field_free(S)
+        return -1
+    memcpy(S.xy, xy, 2 * nv * sizeof(double))
+    memcpy(S.w, w, nv * sizeof(double))
+    memcpy(S.g, g, nv * sizeof(double))
+    memcpy(S.tv, tv, 3 * nt * sizeof(int32_t))
+    memcpy(S.nb, nb, 3 * nt * sizeof(int32_t))
+    S.nv = nv
+    S.nt = nt
+    return 0
+
+
+cdef inline double _side(const double* a, const double* b, double x, double y) noexcept nogil:
+    # twice the signed area of (a, b, p): > 0 when p is left of a -> b (floating
+    # point is enough: the result only weighs sizes, it never decides topology)
+    return (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
+
+
+cdef int size_locate(SizeField* S, double x, double y) noexcept nogil:
+    """The background triangle holding (x, y), or the last one a walk towards it
+    reached (at the hull, or after as many steps as there are triangles: rounding can
+    make a walk circle, and any nearby triangle gives a good enough size)."""
+    cdef int t = S.hint, step, k, j, n
+    cdef const int32_t* v
+    if t < 0 or t >= S.nt:
+        t = 0
+    for step in range(S.nt):
+        v = &S.tv[3 * t]
+        n = -1
+        for j in range(3):
+            k = (j + step) % 3      # rotate the first edge tried: no walk cycles for good
+            if _side(&S.xy[2 * v[(k + 1) % 3]], &S.xy[2 * v[(k + 2) % 3]], x, y) < 0.0:
+                n = S.nb[3 * t + k]
+                break
+        if n < 0:
+            break
+        t = n
+    S.hint = t
+    return t
+
+
+cdef inline double _grown(double h, double dist, double rate, double reach) noexcept nogil:
+    # a size h held out to reach * h, growing at `rate` beyond
+    dist -= reach * h
+    return h + rate * dist if dist > 0.0 else h
+
+
+cdef inline double _cone(const SizeField* S, int v, double x, double y) noexcept nogil:
+    cdef double dx = x - S.xy[2 * v], dy = y - S.xy[2 * v + 1]
+    return _grown(S.g[v], sqrt(dx * dx + dy * dy), S.rate, S.reach)
+
+
+cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
+    cdef int t, k, j, n, a
+    cdef double lam[3]
+    cdef double s = 0.0, h = 0.0, c
+    cdef const int32_t* v
+    if S.nt == 0:
+        return S.constant
+    t = size_locate(S, x, y)
+    v = &S.tv[3 * t]
+    for k in range(3):
+        lam[k] = _side(&S.xy[2 * v[(k + 1) % 3]], &S.xy[2 * v[(k + 2) % 3]], x, y)
+        if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
+            lam[k] = 0.0
+        s += lam[k]
+    if not s > 0.0:
+        lam[0] = lam[1] = lam[2] = 1.0
+        s = 3.0
+    for k in range(3):
+        if isinf(S.w[v[k]]):
+            h = INFINITY
+            break
+        h += lam[k] * S.w[v[k]]
+    h /= s
+    for k in range(3):
+        c = _cone(S, v[k], x, y)
+        if c < h:
+            h = c
+        n = S.nb[3 * t + k]
+        if n >= 0:
+            for j in range(3):
+                if S.nb[3 * n + j] == t:
+                    a = S.tv[3 * n + j]
+                    c = _cone(S, a, x, y)
+                    if c < h:
+                        h = c
+                    break
+    return h
+
+
+cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil:
+    """size_at, with the walk started where the last look-up made from mesh vertex v
+    ended (a look-up near v: Compute_new_candidate's, at the middle of an edge of v).
+    The front jumps across the domain between steps, and the walk from the last
+    look-up anywhere would then cross the background."""
+    cdef int32_t* grown
+    cdef int cap, i
+    cdef double h
+    if S.nt == 0 or v < 0:
+        return size_at(S, x, y)
+    if v >= S.vhint_cap:
+        cap = 2 * v + 64
+        grown = <int32_t*> realloc(S.vhint, cap * sizeof(int32_t))
+        if grown == NULL:
+            return size_at(S, x, y)     # no cache: only the walks are longer
+        for i in range(S.vhint_cap, cap):
+            grown[i] = -1
+        S.vhint = grown
+        S.vhint_cap = cap
+    if S.vhint[v] >= 0:
+        S.hint = S.vhint[v]
+    h = size_at(S, x, y)
+    S.vhint[v] = S.hint
+    return h
+
+
+# ------------------------------------------------ gradation limit on a graph
+
+cdef inline void _heap_push(double* key, int32_t* item, int* n, double k, int32_t v) noexcept nogil:
+    cdef int i = n[0], p
+    n[0] += 1
+    while i > 0:
+        p = (i - 1) >> 1
+        if key[p] <= k:
+            break
+        key[i] = key[p]
+        item[i] = item[p]
+        i = p
+    key[i] = k
+    item[i] = v
+
+
+cdef inline int32_t _heap_pop(double* key, int32_t* item, int* n) noexcept nogil:
+    cdef int32_t top = item[0], v
+    cdef double k
+    cdef int i = 0, c
+    n[0] -= 1
+    k = key[n[0]]
+    v = item[n[0]]
+    while True:
+        c = 2 * i + 1
+        if c >= n[0]:
+            break
+        if c + 1 < n[0] and key[c + 1] < key[c]:
+            c += 1
+        if key[c] >= k:
+            break
+        key[i] = key[c]
+        item[i] = item[c]
+        i = c
+    key[i] = k
+    item[i] = v
+    return top
+
+
+cdef int limit_gradation_graph(int nv, const int32_t* start, const int32_t* adj,
+                               const double* xy, double* h, double rate,
+                               double reach) noexcept nogil:
+    """In place: the largest h' <= h with h'[v] <= _grown(h'[u], |uv|) along the edges
+    (adj[start[u]:start[u + 1]] are u's neighbours), by Dijkstra from the smallest
+    sizes out: each vertex is settled once, so the cost is O(E log E).  0 or ERR_NOMEM."""
+    cdef int cap = start[nv] + nv, n = 0, i
+    cdef int32_t u, v
+    cdef double d, dx, dy
+    cdef double* key = <double*> malloc(cap * sizeof(double))
+    cdef int32_t* item = <int32_t*> malloc(cap * sizeof(int32_t))
+    cdef char* done = <char*> malloc(nv + 1)
+    if key == NULL or item == NULL or done == NULL:
+        free(key)
+        free(item)
+        free(done)
+        return -1
+    for u in range(nv):
+        done[u] = 0
+        if not isinf(h[u]):
+            _heap_push(key, item, &n, h[u], u)
+    while n > 0:
+        u = _heap_pop(key, item, &n)
+        if done[u]:
+            continue
+        done[u] = 1
+        for i in range(start[u], start[u + 1]):
+            v = adj[i]
+            if done[v]:
+                continue
+            dx = xy[2 * v] - xy[2 * u]
+            dy = xy[2 * v + 1] - xy[2 * u + 1]
+            d = _grown(h[u], sqrt(dx * dx + dy * dy), rate, reach)
+            if d < h[v]:
+                h[v] = d
+                _heap_push(key, item, &n, d, v)
+    free(key)
+    free(item)
+    free(done)
+    return 0

@@ -71,20 +71,26 @@ def test_size_callable_of_the_wrong_shape_is_refused(result, shape):
         aftmesh.generate(SQUARE, result)
 
 
-def test_size_callable_values_identical_to_elementwise_grid():
-    # the callable sees each grid node once, in the grid's own order
+def test_size_callable_is_sampled_in_a_few_batched_calls():
+    """The callable gets 1-D float64 arrays, a bounded number of times and points in
+    all (sizing.RESOLVE_ROUNDS, RESOLVE_EVALUATIONS); the field asks for no more than
+    it gave at the background's vertices, and at the samples it did not keep, no more
+    than RESOLVE_TOLERANCE above it."""
+    from aftmesh.sizing import RESOLVE_EVALUATIONS, RESOLVE_ROUNDS, RESOLVE_TOLERANCE
+
     calls = []
 
     def size(x, y):
+        assert x.ndim == 1 and x.shape == y.shape and x.dtype == np.float64
         calls.append(np.c_[x, y].copy())
         return 0.05 + 0.05 * x * y
 
     mesh = aftmesh.generate(SQUARE, size)
     field = mesh.info["size_field"]
-    ny, nx = field.h.shape
-    last = calls[-1]
-    assert len(last) == nx * ny
-    xs = field.x0 + field.dx * np.arange(nx)
-    ys = field.y0 + field.dy * np.arange(ny)
-    X, Y = np.meshgrid(xs, ys)
-    assert np.array_equal(last[:, 0], X.ravel()) and np.array_equal(last[:, 1], Y.ravel())
+    assert 1 < len(calls) <= RESOLVE_ROUNDS + 1
+    assert sum(map(len, calls)) <= RESOLVE_EVALUATIONS + len(field.points)
+    seen = np.concatenate(calls)
+    asked = 0.05 + 0.05 * seen[:, 0] * seen[:, 1]
+    assert np.all(field(seen[:, 0], seen[:, 1]) <= asked * (1 + RESOLVE_TOLERANCE))
+    p = field.points
+    assert np.all(field(p[:, 0], p[:, 1]) <= (0.05 + 0.05 * p[:, 0] * p[:, 1]) * (1 + 1e-12))

@@ -782,18 +782,21 @@ def test_two_lines_ending_at_one_point_within_rounding_of_an_edge(checked):
 
 
 def test_boundary_edge_lengths_hold_next_to_the_boundary():
-    """The size field takes each boundary edge's length at the grid nodes around its
-    vertices.  Growing it at the gradation rate from the vertex itself (done against
-    tiny edges flooding a cell) made the field miss the boundary's sizes next to a
-    graded boundary: the naca0012 benchmark's mean radius ratio fell from 0.962 to
-    0.940 (found by re-running the benchmarks).  Now the length holds out to
-    BOUNDARY_REACH edge lengths and grows beyond, so a tiny edge still cannot flood a
-    cell."""
+    """A boundary edge's length is the size at its ends and holds out to
+    BOUNDARY_REACH lengths before growing at the gradation rate.  Growing from the
+    vertex itself made the first layer on a graded boundary larger than its edges
+    (the naca0012 benchmark's mean radius ratio fell from 0.962 to 0.940).  The field
+    is a background triangulation, not a grid, so a tiny edge keeps its own size
+    instead of being floored at a fraction of a grid cell."""
     from aftmesh.sizing import BOUNDARY_REACH, make_size_field
 
     bounds = ((0.0, 0.0), (100.0, 100.0))
-    f = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([0.5]))
-    assert f.dx > 0.1 and f.dx * np.sqrt(2) < BOUNDARY_REACH * 0.5  # nodes within reach
+    f = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([0.5]), gradation=1.3)
     assert f(50.1, 50.1) == pytest.approx(0.5, rel=1e-12)
+    assert f(50.1 + 0.9 * BOUNDARY_REACH * 0.5, 50.1) == pytest.approx(0.5, rel=1e-12)
+    d = BOUNDARY_REACH * 0.5 + 1.0
+    assert f(50.1 + d, 50.1) == pytest.approx(0.5 + 0.3 * 1.0, rel=1e-9)
     tiny = make_size_field(1.0, bounds, np.array([[50.1, 50.1]]), np.array([1e-6]))
-    assert tiny(50.1, 50.1) > 1e3 * 1e-6  # not spread over the whole cell
+    assert tiny(50.1, 50.1) == pytest.approx(1e-6, rel=1e-9)
+    assert tiny(52.1, 50.1) == pytest.approx(1e-6 + 0.3 * (2.0 - BOUNDARY_REACH * 1e-6), rel=1e-9)
+    assert tiny(90.0, 90.0) == 1.0  # the user's size far away

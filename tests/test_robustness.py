@@ -505,7 +505,7 @@ INVALID = [
     (
         "size-callable-nan-spot",
         lambda: aftmesh.generate(
-            SQ, lambda x, y: np.where(np.hypot(x - 0.5, y - 0.5) < 0.1, np.nan, 0.1)
+            SQ, lambda x, y: np.where(np.hypot(x - 0.5, y - 0.5) < 0.3, np.nan, 0.1)
         ),
         InvalidSizeError,
         ["nan"],
@@ -858,16 +858,19 @@ def test_size_tiny_in_one_spot(h0, checked):
 
 @pytest.mark.parametrize("bad", [np.nan, -1.0, 0.0, np.inf, -np.inf])
 def test_size_bad_in_one_spot(bad):
+    """A bad value over a spot a few sizes wide is seen: the callable is sampled at
+    least every RESOLVE_COARSEST sizes (narrower spots are the next test's case)."""
+
     def size(x, y):
-        return np.where(np.hypot(x - 0.3, y - 0.4) < 0.05, bad, 0.1)
+        return np.where(np.hypot(x - 0.4, y - 0.5) < 0.3, bad, 0.1)
 
     with pytest.raises(InvalidSizeError):
         fd.isolated(aftmesh.generate, SQ, size, timeout=GEN_TIMEOUT)
 
 
 @pytest.mark.parametrize("bad", [np.nan, -1.0])
-def test_size_bad_at_one_point_between_grid_nodes(bad, checked):
-    """Bad only exactly at one point the grid may not sample: refused, or unseen and
+def test_size_bad_at_one_point_between_samples(bad, checked):
+    """Bad only exactly at one point the sampling may miss: refused, or unseen and
     the mesh is fine (the kernel never reads the callable itself)."""
 
     def size(x, y):

@@ -76,24 +76,31 @@ def _progress_callback(progress, expected_triangles: int):
 
 
 def expected_triangles(field: SizeField, area: float, gradation: float) -> float:
-    """About how many triangles the size field asks for on `area`.  On a grid, a
-    node's cell is counted at most as a graded disk around a tiny size would be (the
-    count around a point where h grows linearly from h0 is only logarithmic in 1/h0),
-    so one tiny feature does not make the estimate explode."""
+    """About how many triangles the size field asks for on `area`: the integral of
+    1 / (equilateral area of h) over the background's triangles, scaled to the
+    domain's share of them.  Each triangle counts the larger of its centroid's size
+    over its area and the graded disks around its corners (around a vertex of size g
+    with h growing at rate r, the count within radius R is about
+    2 pi / r^2 * ln(1 + r R / g), only logarithmic in 1/g), so one tiny feature does not
+    make the estimate explode, nor vanish inside a large triangle."""
     with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
-        if field.h.size == 1:
+        if field.is_constant:
             return float(
                 np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min)) / field.h_min
             )
-        h = field.h
-        rate = max(gradation - 1.0, MIN_ESTIMATE_RATE)
-        cell = field.dx * field.dy
-        dense = cell / (EQUILATERAL_AREA * h) / h
-        graded = (2 * np.pi / (EQUILATERAL_AREA * rate * rate)) * (
-            1.0 + np.log1p(rate * max(field.dx, field.dy) / h)
-        )
-        grid_area = cell * h.size
-        return float(np.minimum(dense, graded).sum() * min(1.0, area / grid_area) * ESTIMATE_MARGIN)
+        p = field.points[field.triangles]
+        e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
+        tri_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        c = p.mean(axis=1)
+        hc = field(c[:, 0], c[:, 1])
+        dense = tri_area / (EQUILATERAL_AREA * hc * hc)
+        rate = max(field.rate, MIN_ESTIMATE_RATE)
+        g = field.graded[field.triangles]
+        radius = np.linalg.norm(p - c[:, None, :], axis=2)
+        # each corner is a third of a disk on average (the angles sum to pi)
+        disks = (2 * np.pi / 3 / (EQUILATERAL_AREA * rate * rate)) * np.log1p(rate * radius / g)
+        total = np.maximum(dense, disks.sum(axis=1)).sum()
+        return float(total * min(1.0, area / max(tri_area.sum(), 1e-300)) * ESTIMATE_MARGIN)
 
 
 def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
@@ -206,7 +213,7 @@ def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) 
 
 def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Options):
     """Give the CDT's pieces their regions, check the domain has area and fits
-    max_triangles, and hand the size grid and options to the kernel."""
+    max_triangles, and hand the size field and options to the kernel."""
     kernel = boundary.built.kernel
     if dom.polygons is not None:
         comp, probes, corners = kernel.components()
@@ -224,7 +231,7 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
     min_area = opts.min_area
     if min_area is None:
         min_area = MIN_AREA_FRACTION * (np.sqrt(3) / 4) * field.h_min**2
-    kernel.set_size_grid(field.x0, field.y0, field.dx, field.dy, field.h)
+    kernel.set_size_field(*field.kernel_args())
     kernel.set_options(
         order=ORDERS[opts.order],
         max_triangles=-1 if opts.max_triangles is None else opts.max_triangles,

@@ -13,8 +13,8 @@ import numpy as np
 
 from .sizing import SizeField
 
-# Points per segment at which the size is read to integrate 1/h: the size field is a
-# graded grid, so 31 intervals follow it closely along any one input edge.
+# Points per segment at which the size is read to integrate 1/h: the size field is
+# graded, so 31 intervals follow it closely along any one input edge.
 _SAMPLES = 32
 # Below this relative difference of h between two samples, 1/h is integrated as the
 # mean of the ends (the exact log formula would divide by nearly zero).

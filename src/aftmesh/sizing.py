@@ -1,24 +1,30 @@
-"""Size specifications -> the compiled size field (a background grid).
+"""Size specifications -> the compiled size field.
 
 A user's ``size`` is a number (the target edge length everywhere), a callable
 ``f(x, y) -> array`` evaluated on whole arrays at once (never one call per point: x
 and y are 1-D arrays of equal length, the result one size per point or a scalar), or
 ``None`` (sizes taken from the lengths of the boundary's own edges and spread inward).
-Whatever it is, it becomes a regular grid of target lengths that the kernel
-interpolates bilinearly, after a gradation limit has been applied so that the size
-never grows faster than ``gradation`` per unit of length relative to itself
-(h(x) <= h(y) + (gradation - 1) |x - y|).
+
+Whatever it is, it is combined with what the boundary asks for (an input edge shorter
+than the size keeps its length as the size at its ends) and gradation-limited, so that
+the size never grows faster than ``gradation`` per unit of length relative to itself
+(h(x) <= h(y) + (gradation - 1) |x - y|).  The result is a constant, or sizes at the
+vertices of a background Delaunay triangulation of the input vertices (plus the points
+where a callable needed more samples), read by the kernel as cython_ext/sizing.pxi
+says.  So the field costs what the input costs, never what its bounding box spans:
+a long thin domain or a tiny edge does not make it bigger.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._kernel import limit_gradation_grid
+from . import _kernel
+from ._order import brio_order
 from ._typing import Point2, SizeFunction
 from .errors import InvalidSizeError
 
@@ -27,65 +33,101 @@ if TYPE_CHECKING:
 
 __all__ = ["SizeField", "make_size_field"]
 
-# The background grid has at most this many nodes along its longer side.
-MAX_GRID = 512
 DEFAULT_GRADATION = 1.3
 # A user's size must span at least this many units in the last place of the domain's
 # largest coordinate: new vertices are rounded to the nearest double, by up to half a
 # unit per coordinate, so below this the mesh could not have the size asked for (and
 # at a few units, the points that split an edge would coincide).
 MIN_SIZE_ULPS = 64
-# How far (in its own edge lengths) a boundary edge's length holds as the size before
-# it grows at the gradation rate (see make_size_field).
-BOUNDARY_REACH = 10.0
-# A constant size needs no grid when no input edge is shorter than this fraction of
-# it: the discretization rounds the number of pieces, so edges a little shorter than
-# the size are met anyway.
+# A constant size needs no background when no input edge is shorter than this fraction
+# of it: the discretization rounds the number of pieces, so edges a little shorter
+# than the size are met anyway.
 CONSTANT_IF_EDGES_ABOVE = 0.8
-# The grid reaches this fraction of the domain's span beyond its bounding box, so
-# points proposed just outside an edge still read a size from inside the grid.
-GRID_PAD = 0.02
-# The coarsest grid spacing, as a fraction of the domain's span: finer features of a
-# size callable than that are not seen by the first, coarse look.
-COARSE_CELLS = 64
-# The grid spacing is at most this fraction of the smallest size it must resolve
-# (two nodes per size: bilinear interpolation then follows it closely).
-NODES_PER_SIZE = 0.5
+# The background's corners lie this fraction of the domain's span beyond its bounding
+# box, so points proposed just outside an edge still read a size from inside it.
+BOX_PAD = 0.02
+# A size callable is sampled at the midpoint of every background edge, and the
+# midpoint becomes a background vertex where linear interpolation between the edge's
+# ends misses the callable by more than this fraction ...
+RESOLVE_TOLERANCE = 0.2
+# ... unless the edge is already shorter than this many times the size there: the
+# mesh cannot follow finer variation than its own edges anyway.
+RESOLVE_SPAN = 1.0
+# ... and an edge longer than this many times the size at its midpoint is split
+# anyway: a callable is seen at least that closely everywhere (a feature of it
+# narrower than that, far from the boundary, may go unseen).
+RESOLVE_COARSEST = 8
+# Sampling rounds (each one batched call of the callable) and evaluations in all: the
+# bound on what a callable costs, whatever it does (a callable varying at every scale
+# gets this much resolution and no more).
+RESOLVE_ROUNDS = 24
+RESOLVE_EVALUATIONS = 20_000
+# How far (in its own lengths) a boundary edge's length holds as the size before it
+# grows at the gradation rate: the first layer of triangles on a boundary is as large
+# as its edges, and a short edge's size does not reach far.
+BOUNDARY_REACH = 1.0
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SizeField:
-    """Target edge length on a regular grid: ``h[j, i]`` at ``(x0 + i dx, y0 + j dy)``."""
+    """Target edge length: ``constant`` when the background is empty, otherwise read
+    from the background triangulation (``points``, ``triangles``, ``neighbors``) with
+    the user's size ``user`` and the graded boundary size ``graded`` at its vertices
+    (cython_ext/sizing.pxi).  Calling it evaluates the field the kernel uses.
 
-    x0: float
-    y0: float
-    dx: float
-    dy: float
-    h: np.ndarray
+    >>> f = make_size_field(0.5, ((0.0, 0.0), (1.0, 1.0)))
+    >>> float(f(0.3, 0.7)), f.h_min
+    (0.5, 0.5)
+    """
+
+    constant: float
+    points: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    user: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    graded: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    triangles: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int32))
+    neighbors: np.ndarray = field(default_factory=lambda: np.zeros((0, 3), dtype=np.int32))
+    rate: float = 0.0
+    reach: float = 0.0
+
+    @property
+    def is_constant(self) -> bool:
+        return len(self.triangles) == 0
+
+    @property
+    def h(self) -> np.ndarray:
+        """The size at the background's vertices (the constant, if there are none)."""
+        if self.is_constant:
+            return np.array([self.constant])
+        return np.minimum(self.user, self.graded)
 
     @property
     def h_min(self) -> float:
+        """The smallest size anywhere (interpolation and cones never go below the
+        vertices' values)."""
         return float(self.h.min())
 
+    def kernel_args(self) -> tuple:
+        """The arguments of the kernel's ``set_size_field`` / ``size_field_eval``."""
+        return (
+            float(self.constant),
+            self.points,
+            self.user,
+            self.graded,
+            self.triangles,
+            self.neighbors,
+            float(self.rate),
+            float(self.reach),
+        )
+
     def __call__(self, x, y) -> np.ndarray:
-        """Bilinear interpolation, clamped outside the grid (as the kernel does it)."""
+        """The size at the points (x, y) (arrays of any one shape)."""
         x = np.asarray(x, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
-        ny, nx = self.h.shape
-        if nx == 1 and ny == 1:
-            return np.full(np.broadcast(x, y).shape, self.h[0, 0])
-        fx = np.clip((x - self.x0) / self.dx, 0, nx - 1) if nx > 1 else np.zeros_like(x)
-        fy = np.clip((y - self.y0) / self.dy, 0, ny - 1) if ny > 1 else np.zeros_like(y)
-        i = np.minimum(fx.astype(np.int64), max(nx - 2, 0))
-        j = np.minimum(fy.astype(np.int64), max(ny - 2, 0))
-        tx = fx - i
-        ty = fy - j
-        i1 = np.minimum(i + 1, nx - 1)
-        j1 = np.minimum(j + 1, ny - 1)
-        h = self.h
-        return (1 - ty) * ((1 - tx) * h[j, i] + tx * h[j, i1]) + ty * (
-            (1 - tx) * h[j1, i] + tx * h[j1, i1]
-        )
+        shape = np.broadcast(x, y).shape
+        if self.is_constant:
+            return np.full(shape, self.constant)
+        xb, yb = (np.ascontiguousarray(np.broadcast_to(v, shape)).reshape(-1) for v in (x, y))
+        return _kernel.size_field_eval(*self.kernel_args(), xb, yb).reshape(shape)
 
 
 def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> None:
@@ -98,10 +140,15 @@ def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> Non
         )
 
 
+def _resolution(bounds) -> float:
+    """The spacing of doubles at the domain's largest coordinate."""
+    return float(np.spacing(float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))))
+
+
 def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
     """Refuse sizes finer than the coordinates can resolve (see MIN_SIZE_ULPS)."""
     magnitude = float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))
-    spacing = float(np.spacing(magnitude))
+    spacing = _resolution(bounds)
     k = int(np.argmin(h))
     if h.ravel()[k] < MIN_SIZE_ULPS * spacing:
         where = "" if X is None else f" at ({X.ravel()[k]:.9g}, {Y.ravel()[k]:.9g})"
@@ -114,7 +161,7 @@ def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
 
 
 def _evaluate(size, X: np.ndarray, Y: np.ndarray) -> np.ndarray:
-    """The user's size at the grid nodes, in one call: ``size(x, y)`` with x and y
+    """The user's size at the points (x, y), in one call: ``size(x, y)`` with x and y
     1-D arrays of equal length (the nodes row by row), returning that many sizes or
     one number.  1-D because that is what point-based tools take (``np.c_[x, y]``,
     KD-trees, interpolators, ``shapely.distance`` of points)."""
@@ -179,37 +226,73 @@ def per_region_size(polygons: Sequence[shapely.Polygon], sizes: Iterable[float])
     return size
 
 
-def limit_gradation(h: np.ndarray, dx: float, dy: float, gradation: float) -> np.ndarray:
-    """Smallest field <= h with h(p) <= h(q) + (gradation - 1) * |p - q| along paths of
-    grid nodes (the kernel's 8-neighbour sweeps)."""
-    if gradation <= 1.0 or h.size <= 1:
-        return h
-    out = np.ascontiguousarray(h, dtype=np.float64).copy()
-    limit_gradation_grid(out, float(dx), float(dy), float(gradation - 1.0))
-    return out
+def _parse_size(size) -> float | None:
+    """The constant of a number size (checked), None for a callable or None."""
+    if isinstance(size, (bool, np.bool_, str, bytes)):
+        # float() would take True as 1 and "0.1" as 0.1: almost surely a mistake
+        raise InvalidSizeError(f"size must be a number, a callable f(x, y) or None, got {size!r}")
+    if size is None or callable(size):
+        return None
+    try:
+        constant = float(size)
+    except (TypeError, ValueError):
+        raise InvalidSizeError(
+            f"size must be a number, a callable f(x, y) or None, got {size!r}"
+        ) from None
+    if not (np.isfinite(constant) and constant > 0):
+        raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
+    return constant
 
 
-def _nodes(bounds, spacing: float):
-    """The grid's origin, spacings and node coordinates along x and along y."""
+def _box_corners(bounds) -> np.ndarray:
     (xmin, ymin), (xmax, ymax) = bounds
-    span = max(xmax - xmin, ymax - ymin)
-    spacing = max(spacing, span / (MAX_GRID - 1))
-    nx = int(np.ceil((xmax - xmin) / spacing)) + 1
-    ny = int(np.ceil((ymax - ymin) / spacing)) + 1
-    nx = max(nx, 2)
-    ny = max(ny, 2)
-    dx = (xmax - xmin) / (nx - 1) if xmax > xmin else 1.0
-    dy = (ymax - ymin) / (ny - 1) if ymax > ymin else 1.0
-    xs = xmin + dx * np.arange(nx)
-    ys = ymin + dy * np.arange(ny)
-    return xmin, ymin, dx, dy, xs, ys
+    pad = BOX_PAD * max(xmax - xmin, ymax - ymin)
+    x0, y0, x1, y1 = xmin - pad, ymin - pad, xmax + pad, ymax + pad
+    return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
 
 
-def _grid(bounds, spacing: float):
-    """As :func:`_nodes`, with the nodes' coordinates as two full 2-D arrays."""
-    x0, y0, dx, dy, xs, ys = _nodes(bounds, spacing)
-    X, Y = np.meshgrid(xs, ys)
-    return x0, y0, dx, dy, X, Y
+def _edge_keys(tv: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The background's edges, each once: (keys, (e, 2) vertex pairs)."""
+    e = np.concatenate([tv[:, [0, 1]], tv[:, [1, 2]], tv[:, [2, 0]]]).astype(np.int64)
+    e.sort(axis=1)
+    keys, first = np.unique(e[:, 0] * n + e[:, 1], return_index=True)
+    return keys, e[first]
+
+
+def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
+    """Sample the callable at the midpoints of the background's edges, round by round
+    (one call each), and split the edges where interpolating between their ends
+    misses it (RESOLVE_TOLERANCE) while longer than the size there (RESOLVE_SPAN), or
+    where they are longer than RESOLVE_COARSEST sizes.  An edge that passed once is
+    not sampled again while it lasts."""
+    passed = np.zeros(0, dtype=np.int64)
+    calls = 0
+    n_max = len(pts) + RESOLVE_EVALUATIONS
+    for _ in range(RESOLVE_ROUNDS):
+        tv, _nb = tri.finite_triangles()
+        keys, edges = _edge_keys(tv, n_max)
+        todo = ~np.isin(keys, passed, assume_unique=True)
+        keys, edges = keys[todo], edges[todo]
+        if len(keys) == 0 or calls + len(keys) > RESOLVE_EVALUATIONS:
+            break
+        a, b = pts[edges[:, 0]], pts[edges[:, 1]]
+        mid = 0.5 * (a + b)
+        um = _evaluate(size, mid[:, 0], mid[:, 1])
+        calls += len(keys)
+        _check_resolution(um, mid[:, 0], mid[:, 1], bounds, "the size callable gave")
+        length = np.linalg.norm(b - a, axis=1)
+        miss = np.abs(0.5 * (u[edges[:, 0]] + u[edges[:, 1]]) - um) > RESOLVE_TOLERANCE * um
+        bad = (miss & (length > RESOLVE_SPAN * um)) | (length > RESOLVE_COARSEST * um)
+        passed = np.concatenate([passed, keys[~bad]])
+        if not bad.any():
+            break
+        new = mid[bad]
+        order = brio_order(new)  # short walks between consecutive insertions
+        new, u_new = np.ascontiguousarray(new[order]), um[bad][order]
+        tri.add_points(new)
+        pts = np.concatenate([pts, new])
+        u = np.concatenate([u, u_new])
+    return pts, u
 
 
 def make_size_field(
@@ -222,8 +305,8 @@ def make_size_field(
     """Turn a size specification into a :class:`SizeField` over ``bounds``.
 
     The field is the smaller of the user's size and the sizes the boundary itself asks
-    for: an input edge shorter than the user's size is kept, so the size near its ends
-    is that edge's length, growing away from it at the gradation rate.  Without that,
+    for: an input edge shorter than the user's size is kept, so the size at its ends
+    is that edge's length, growing away from them at the gradation rate.  Without that,
     a triangle built on a short edge would have to be either a needle or much smaller
     than its neighbours.
 
@@ -240,80 +323,53 @@ def make_size_field(
     """
     if gradation is None or not np.isfinite(gradation) or gradation < 1.0:
         raise InvalidSizeError(f"gradation must be a finite number >= 1, got {gradation!r}")
-    constant = None
-    if isinstance(size, (bool, np.bool_, str, bytes)):
-        # float() would take True as 1 and "0.1" as 0.1: almost surely a mistake
-        raise InvalidSizeError(f"size must be a number, a callable f(x, y) or None, got {size!r}")
-    if size is not None and not callable(size):
-        try:
-            constant = float(size)
-        except (TypeError, ValueError):
-            raise InvalidSizeError(
-                f"size must be a number, a callable f(x, y) or None, got {size!r}"
-            ) from None
-        if not (np.isfinite(constant) and constant > 0):
-            raise InvalidSizeError(f"size must be finite and positive, got {size!r}")
+    constant = _parse_size(size)
+    if constant is not None:
         _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
     if constant is not None and (
         not have_boundary or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant
     ):
-        # the boundary asks for nothing smaller: a constant needs no grid
-        return SizeField(0.0, 0.0, 1.0, 1.0, np.array([[constant]]))
+        # the boundary asks for nothing smaller: a constant needs no background
+        return SizeField(constant)
     if size is None and not have_boundary:
         raise InvalidSizeError("size=None takes the size from the input edges, but there are none")
-    (xmin, ymin), (xmax, ymax) = bounds
-    span = max(xmax - xmin, ymax - ymin)
-    pad = GRID_PAD * span
-    bounds = ((xmin - pad, ymin - pad), (xmax + pad, ymax + pad))
-    spacing = span / COARSE_CELLS
+    corners = _box_corners(bounds)
+    pts = corners
+    lengths = np.full(4, np.inf)
     if have_boundary:
-        spacing = min(spacing, NODES_PER_SIZE * float(np.min(boundary_lengths)))
+        pts = np.concatenate([np.asarray(boundary_points, dtype=np.float64), corners])
+        # an edge shorter than the coordinates resolve (see MIN_SIZE_ULPS) stays as it
+        # is, but asks for no smaller size around it: split points closer than that
+        # would round onto each other
+        floor = MIN_SIZE_ULPS * _resolution(bounds)
+        edges = np.maximum(np.asarray(boundary_lengths, dtype=np.float64), floor)
+        lengths = np.concatenate([edges, lengths])
+    pts = np.ascontiguousarray(pts)
     if callable(size):
-        # a coarse look first, to pick a grid spacing fine enough for the smallest size
-        x0, y0, dx, dy, X, Y = _grid(bounds, span / COARSE_CELLS)
-        h0 = _evaluate(size, X, Y)
-        _check_resolution(h0, X, Y, bounds, "the size callable gave")
-        spacing = min(spacing, NODES_PER_SIZE * float(h0.min()))
-    # the full 2-D node coordinates only for a callable: elsewhere node (j, i) is
-    # read as (xs[i], ys[j]), the same numbers without two grid-sized arrays
-    x0, y0, dx, dy, xs, ys = _nodes(bounds, spacing)
-    shape = (len(ys), len(xs))
-    if callable(size):
-        X, Y = np.meshgrid(xs, ys)
-        h = _evaluate(size, X, Y)
-        _check_resolution(h, X, Y, bounds, "the size callable gave")
+        u = _evaluate(size, pts[:, 0], pts[:, 1])
+        _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
     else:
-        h = np.full(shape, np.inf if constant is None else constant)
-    # the growth rate used to spread the boundary's sizes: the user's gradation, or
-    # the default one if the user asked for none (size=None with gradation=1 would
-    # otherwise leave the field infinite away from the boundary)
+        u = np.full(len(pts), np.inf if constant is None else constant)
+    tri = _kernel.Triangulation(pts)
+    tri.insert_points(brio_order(pts))
+    if callable(size):
+        pts, u = _resolve_callable(size, tri, pts, u, bounds)
+        lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
+    tv, nb = tri.finite_triangles()
+    used = np.zeros(len(pts), dtype=bool)
+    used[tv.ravel()] = True  # a point merged into an earlier one is in no triangle
+    w = np.ascontiguousarray(u, dtype=np.float64)
+    if callable(size) and gradation > 1.0:
+        w = w.copy()
+        _kernel.limit_gradation_mesh(pts, tv, w, float(gradation - 1.0))
+    # the boundary's sizes spread at the user's gradation, or the default one if the
+    # user asked for none (size=None with gradation=1 would otherwise leave the field
+    # infinite away from the boundary)
     spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
-    if have_boundary:
-        pts = np.asarray(boundary_points, dtype=np.float64)
-        lengths = np.asarray(boundary_lengths, dtype=np.float64)
-        # each boundary vertex asks for its edge length at the four grid nodes around
-        # it, as is out to BOUNDARY_REACH edge lengths away and growing at the
-        # gradation rate beyond (not the bare length at any distance: a cell can be
-        # far larger than a tiny edge, and bilinear interpolation would spread that
-        # tiny size over the whole cell; nor growing from the vertex itself: the
-        # field would then be larger than the boundary's edges right next to them,
-        # and the first layer of triangles on a graded boundary would be stretched)
-        rate = spread - 1.0
-        i = np.clip(np.floor((pts[:, 0] - x0) / dx).astype(np.int64), 0, shape[1] - 2)
-        j = np.clip(np.floor((pts[:, 1] - y0) / dy).astype(np.int64), 0, shape[0] - 2)
-        for di in (0, 1):
-            for dj in (0, 1):
-                dist = np.hypot(xs[i + di] - pts[:, 0], ys[j + dj] - pts[:, 1])
-                np.minimum.at(
-                    h,
-                    (j + dj, i + di),
-                    lengths + rate * np.maximum(0.0, dist - BOUNDARY_REACH * lengths),
-                )
-    limit = spread if not np.isfinite(h).all() else gradation
-    if limit > 1.0 and h.size > 1:
-        # as limit_gradation, in place: h is this function's own C-ordered array
-        limit_gradation_grid(h, float(dx), float(dy), float(limit - 1.0))
-    if not np.isfinite(h).all():
+    g = np.minimum(w, lengths)
+    _kernel.limit_gradation_mesh(pts, tv, g, float(spread - 1.0))
+    if not np.isfinite(g[used]).all():
         raise InvalidSizeError("could not derive a size from the boundary")
-    return SizeField(float(x0), float(y0), float(dx), float(dy), np.ascontiguousarray(h))
+    g[~used] = np.inf  # never read: only the triangles' vertices are
+    return SizeField(constant or 0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)

@@ -1,0 +1,107 @@
+"""The size field (sizing.py, cython_ext/sizing.pxi): sizes on a background
+triangulation of the input, so its cost follows the input and it realises sizes a
+grid could not.  Each test measures the size the mesh realises against the size asked.
+"""
+
+import numpy as np
+import pytest
+from shapely import Polygon, box
+
+import aftmesh
+from aftmesh import examples
+from aftmesh.sizing import BOUNDARY_REACH, RESOLVE_EVALUATIONS, make_size_field
+
+
+# triangles per factor e between the chamfer's size and the square's, around one
+# corner: a quarter of the 2 pi / (0.43 rate^2) of a full graded disk (rate 0.3),
+# with a margin
+RINGS_PER_E_FOLD = 150
+
+
+def _edges_at(mesh, vertex: int) -> np.ndarray:
+    """Lengths of the mesh edges at one vertex."""
+    e = np.asarray(mesh.edges)
+    at = e[(e[:, 0] == vertex) | (e[:, 1] == vertex)]
+    p = np.asarray(mesh.points)
+    return np.linalg.norm(p[at[:, 0]] - p[at[:, 1]], axis=1)
+
+
+def _vertex(mesh, xy) -> int:
+    p = np.asarray(mesh.points)
+    return int(np.flatnonzero((p == np.asarray(xy, dtype=float)).all(axis=1))[0])
+
+
+@pytest.mark.parametrize("cut", [1e-6, 1e-8])
+def test_short_edge_gets_its_own_size_and_good_angles(cut, checked):
+    """A unit square with one corner cut by a tiny chamfer: the background grid could
+    not go below about 0.3 of a cell there, so the triangles on the chamfer were
+    needles (0.62 degrees at 1e-6, 0.007 at 1e-8).  Now the size next to the chamfer
+    is its own length, and every angle meets the bound (no input angle is small)."""
+    poly = Polygon([(0, 0), (1, 0), (1, 1 - cut), (1 - cut, 1), (0, 1)])
+    mesh = checked(aftmesh.generate(poly, 0.05), domain_area=poly.area, area_rtol=1e-9)
+    chamfer = np.hypot(cut, cut)
+    for corner in ((1, 1 - cut), (1 - cut, 1)):
+        lengths = _edges_at(mesh, _vertex(mesh, corner))
+        assert lengths.min() == pytest.approx(chamfer, rel=1e-6)  # the chamfer itself
+        assert lengths.max() < 4 * chamfer  # the size asked there: the chamfer's length
+    assert mesh.quality()["min_angle"] >= 28.0 - 1e-9
+    # the small size stays local: as many triangles as without the chamfer plus the
+    # graded rings around it, whose number is logarithmic in 0.05 / cut
+    plain = aftmesh.generate(box(0, 0, 1, 1), 0.05)
+    assert len(mesh.triangles) < len(plain.triangles) + RINGS_PER_E_FOLD * np.log(0.05 / cut)
+
+
+def test_field_cost_follows_the_input_not_the_bounding_box():
+    """A long thin domain with one short edge: the field holds the input's vertices
+    and the box's four corners, nothing proportional to the box's area."""
+    ring = [(0, 0), (1000, 0), (1000, 0.01), (500.001, 0.01), (500, 0.01), (0, 0.01)]
+    mesh = aftmesh.generate(Polygon(ring), 0.005)
+    field = mesh.info["size_field"]
+    assert len(field.points) == len(ring) + 4
+    assert field(500.0005, 0.01) == pytest.approx(0.001, rel=1e-6)
+
+
+def test_size_callable_at_a_reentrant_corner_is_honoured(checked):
+    """H r^(1/3) at an L-shape's re-entrant corner (the size a finite-element study of
+    the corner singularity asks for): halving H must make the corner mesh finer, and
+    the edges at the corner follow the callable.  On the grid the corner's size was
+    whatever the nearest grid node gave, so halving H could make it coarser."""
+    L = Polygon([(-1, -1), (1, -1), (1, 1), (0, 1), (0, 0), (-1, 0)])
+    longest = []
+    for H in (0.2, 0.1, 0.05):
+
+        def size(x, y, H=H):
+            return H * np.maximum(np.hypot(x, y), 1e-9) ** (1 / 3)
+
+        mesh = checked(aftmesh.generate(L, size), domain_area=L.area)
+        lengths = _edges_at(mesh, _vertex(mesh, (0, 0)))
+        # an edge of length l from the corner ends where the size is H l^(1/3)
+        asked = H * lengths ** (1 / 3)
+        assert np.all(lengths < 2.0 * asked)
+        longest.append(lengths.max())
+    assert longest[0] > longest[1] > longest[2]
+
+
+def test_callable_costs_a_bounded_number_of_evaluations():
+    """The graded airfoil of the examples: its size callable (a distance to the
+    airfoil) is evaluated at background vertices and edge midpoints, not on a grid
+    over the channel (136,704 evaluations before)."""
+    foil, size = examples.airfoil_channel()
+    count = []
+
+    def counted(x, y):
+        count.append(len(x))
+        return size(x, y)
+
+    aftmesh.generate(foil, counted)
+    assert sum(count) <= RESOLVE_EVALUATIONS
+
+
+def test_reach_then_gradation():
+    """The field at a short edge's end is its length, holds for BOUNDARY_REACH lengths,
+    then grows at the gradation rate, up to the user's size."""
+    f = make_size_field(1.0, ((0.0, 0.0), (10.0, 10.0)), np.array([[5.0, 5.0]]), np.array([0.01]))
+    assert f(5.0, 5.0) == pytest.approx(0.01)
+    assert f(5.0 + BOUNDARY_REACH * 0.01, 5.0) == pytest.approx(0.01)
+    assert f(6.0, 5.0) == pytest.approx(0.01 + 0.3 * (1.0 - BOUNDARY_REACH * 0.01))
+    assert f(9.0, 9.0) == 1.0
