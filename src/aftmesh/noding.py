@@ -14,7 +14,8 @@ import numpy as np
 import shapely
 from shapely.geometry import Point
 
-from ._kernel import py_orient2d
+from ._kernel import CollinearError, CrossingError, Triangulation, py_orient2d
+from ._order import brio_order
 from .errors import CrossingSegmentsError
 
 __all__ = [
@@ -322,17 +323,29 @@ def split_at_vertices(
 
 def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
     """Dict / .poly input: segments crossing at a point inside both are refused (the
-    policy of aftmesh.cdt), before any size-dependent splitting could hide them."""
+    policy of aftmesh.cdt), before any size-dependent splitting could hide them.
+
+    The kernel finds them: the Delaunay triangulation of the points, then the
+    segments inserted one by one as constrained edges (exact predicates; a segment
+    running through a vertex is split there, which is no crossing)."""
     if len(seg) < 2:
         return
-    lines = shapely.linestrings(np.stack([pts[seg[:, 0]], pts[seg[:, 1]]], axis=1))
-    pairs = shapely.STRtree(lines).query(lines, predicate="crosses")
-    pairs = pairs[:, pairs[0] < pairs[1]]
-    if pairs.shape[1]:
-        i, j = (int(x) for x in pairs[:, 0])
+    kernel = Triangulation(pts)
+    try:
+        merged = kernel.insert_points(brio_order(pts))
+    except CollinearError:
+        return  # all on one line: segments may overlap there, never cross
+    try:
+        kernel.insert_segments(np.ascontiguousarray(merged[seg], dtype=np.int32))
+    except CrossingError as err:
+        i, j = sorted((int(err.index), int(err.blocker_segment)))
+        if i < 0:  # cannot happen: every constrained edge here is a piece of an input one
+            raise CrossingSegmentsError(
+                f"segments[{j}] = {seg[j].tolist()} crosses another segment", (j,)
+            ) from None
         raise CrossingSegmentsError(
             f"segments[{i}] = {seg[i].tolist()} ({pts[seg[i, 0]].tolist()} -> "
             f"{pts[seg[i, 1]].tolist()}) crosses segments[{j}] = {seg[j].tolist()} "
             f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})",
             (i, j),
-        )
+        ) from None
