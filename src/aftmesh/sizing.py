@@ -367,7 +367,9 @@ def make_size_field(
     # user asked for none (size=None with gradation=1 would otherwise leave the field
     # infinite away from the boundary)
     spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
-    g = np.minimum(w, lengths)
+    # the user's own size is limited only when asked (gradation > 1): with gradation=1
+    # it is honoured as given, and only the boundary's sizes spread
+    g = np.minimum(w, lengths) if gradation > 1.0 else lengths.copy()
     _kernel.limit_gradation_mesh(pts, tv, g, float(spread - 1.0))
     if not np.isfinite(g[used]).all():
         raise InvalidSizeError("could not derive a size from the boundary")
