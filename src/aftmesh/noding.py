@@ -83,20 +83,37 @@ def merge_and_node(
         verts, n_merged = merge_close(verts, tolerance)
         if n_merged:
             note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
-    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
-    segs = inverse.reshape(-1)[segs]
-    tol = max(snap_tolerance(uniq), tolerance)
+    uniq, inverse = unique_rows(verts)
+    segs = inverse[segs]
+    exact_valid = valid_rings and not tolerance > 0
+    tol = 0.0 if exact_valid and valid_rings == 1 else max(snap_tolerance(uniq), tolerance)
     counts = {"snapped": 0}
     if valid_rings != 1 or tolerance > 0:
         segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    if valid_rings and not tolerance > 0:
+    if exact_valid:
         out = uniq, segs, src
     else:
         out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
     if report is not None and tolerance > 0:
         report.update(merged=n_merged, snapped=counts["snapped"])
     return out
+
+
+def unique_rows(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(pts, axis=0, return_inverse=True)`` (the distinct points in
+    lexicographic order, and each point's index among them), without its cost on
+    the usual input, finite points all distinct: there a lexicographic sort is the
+    whole answer.  Any repeat (or non-finite value) goes to np.unique itself, which
+    also decides which copy of 0.0 / -0.0 is kept."""
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    srt = pts[order]
+    if (srt[1:] == srt[:-1]).all(axis=1).any() or not np.isfinite(srt).all():
+        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
+        return uniq, inverse.reshape(-1)
+    inverse = np.empty(len(pts), dtype=np.intp)
+    inverse[order] = np.arange(len(pts))
+    return srt, inverse
 
 
 def merge_close(verts: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
@@ -136,8 +153,8 @@ def merge_close_segments(
     if not n_merged:
         return pts, segs, src, 0
     note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
-    uniq, inverse = np.unique(moved, axis=0, return_inverse=True)
-    segs, src = _drop_repeats(inverse.reshape(-1)[segs], np.asarray(src))
+    uniq, inverse = unique_rows(moved)
+    segs, src = _drop_repeats(inverse[segs], np.asarray(src))
     return uniq, segs, src, n_merged
 
 
@@ -218,8 +235,8 @@ def node_crossings(
         n_cut += pairs.shape[1]
         verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
         segs, src = _cut(verts, segs, src, cuts)
-        verts, inverse = np.unique(verts, axis=0, return_inverse=True)
-        segs = inverse.reshape(-1)[segs]
+        verts, inverse = unique_rows(verts)
+        segs = inverse[segs]
         segs, src = split_at_vertices(verts, segs, src, None, tol, ring_source)
         segs, src = _drop_repeats(segs, src)
     if n_cut and note is not None:
@@ -257,9 +274,13 @@ def _cut(pts, segs, src, cuts):
 
 
 def _drop_repeats(segs, src):
+    """The segments without those given twice (either way round; the first copy
+    stays) and without those from a vertex to itself, in input order."""
     key = np.sort(segs, axis=1)
     keep = key[:, 0] != key[:, 1]
-    _, first = np.unique(key, axis=0, return_index=True)
+    # one integer per vertex pair, ordered as the pairs are (indices are below 2**31)
+    pair = key[:, 0].astype(np.int64) * (int(key[:, 1].max(initial=0)) + 1) + key[:, 1]
+    _, first = np.unique(pair, return_index=True)
     first = np.sort(first[keep[first]])
     return segs[first], src[first]
 
