@@ -262,7 +262,9 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
         for part in polygon_parts(p, f"region {k}"):
             flat.append(part)
             names.append(f"region {k}")
-    dom = _from_shapely(flat, [], [], [], names, tolerance, area=float(sum(p.area for p in polygons)))
+    dom = _from_shapely(
+        flat, [], [], [], names, tolerance, area=float(sum(p.area for p in polygons))
+    )
     dom.polygons = polygons
     return dom
 
