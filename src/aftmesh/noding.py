@@ -77,7 +77,8 @@ def merge_and_node(
     shapely found valid, that many rings: then no two segments cross (validity
     forbids it, decided with exact predicates as the crossing search would), so the
     search is skipped; with one ring, no vertex lies on another segment either (the
-    ring is simple, and a ring's vertex is never snapped), so the split is skipped."""
+    ring is simple, and a ring's vertex is never snapped), so the split is skipped,
+    and so is the search for repeated segments."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
@@ -86,10 +87,13 @@ def merge_and_node(
     uniq, inverse = unique_rows(verts)
     segs = inverse[segs]
     exact_valid = valid_rings and not tolerance > 0
-    tol = 0.0 if exact_valid and valid_rings == 1 else max(snap_tolerance(uniq), tolerance)
+    if exact_valid and valid_rings == 1:
+        # one simple ring of at least three distinct vertices: no vertex on another
+        # segment, no segment given twice or from a vertex to itself, no crossing
+        return uniq, segs, src
+    tol = max(snap_tolerance(uniq), tolerance)
     counts = {"snapped": 0}
-    if valid_rings != 1 or tolerance > 0:
-        segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
+    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
     if exact_valid:
         out = uniq, segs, src

@@ -51,9 +51,8 @@ def as_points(value: npt.ArrayLike | None, name: str) -> np.ndarray:
         return np.zeros((0, 2), dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidInputError(f"{name} must have shape (n, 2), got {arr.shape}")
-    bad = ~np.isfinite(arr).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    if not np.isfinite(arr).all():
+        i = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
         raise InvalidInputError(f"{name}[{i}] = {arr[i].tolist()} is not finite")
     check_range(arr, name)
     return np.ascontiguousarray(arr)
@@ -62,6 +61,9 @@ def as_points(value: npt.ArrayLike | None, name: str) -> np.ndarray:
 def check_range(arr: np.ndarray, name: str) -> None:
     """Refuse coordinates outside the exact predicates' range (see MAX_COORDINATE)."""
     mag = np.abs(arr)
+    # one look for the usual case, then the row at fault
+    if not (mag.max(initial=0.0) > MAX_COORDINATE or ((mag < MIN_COORDINATE) & (mag > 0)).any()):
+        return
     big = (mag > MAX_COORDINATE).any(axis=1)
     if big.any():
         i = int(np.flatnonzero(big)[0])
@@ -96,13 +98,14 @@ def as_segments(value: npt.ArrayLike | None, n_vertices: int, vertices: np.ndarr
             raise InvalidInputError("segments must hold integer vertex indices")
         raw = as_int
     seg = raw.astype(np.int64)
-    bad = (seg < 0) | (seg >= n_vertices)
-    if bad.any():
+    if seg.min() < 0 or seg.max() >= n_vertices:
+        bad = (seg < 0) | (seg >= n_vertices)
         i = int(np.flatnonzero(bad.any(axis=1))[0])
         raise InvalidInputError(
             f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{n_vertices - 1}"
         )
-    zero = (seg[:, 0] == seg[:, 1]) | (vertices[seg[:, 0]] == vertices[seg[:, 1]]).all(axis=1)
+    a, b = seg[:, 0], seg[:, 1]
+    zero = (a == b) | (vertices[a] == vertices[b]).all(axis=1)
     if zero.any():
         i = int(np.flatnonzero(zero)[0])
         raise InvalidInputError(
