@@ -27,6 +27,7 @@ from shapely.geometry import (
     Polygon,
 )
 
+from ._kernel import ring_chains
 from ._typing import DomainArg
 from .domain_record import Domain
 from .errors import InvalidDomainError
@@ -59,35 +60,11 @@ def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
     # get_rings is several times slower than taking the exterior rings when that is all
     rings = shapely.get_rings(polygons) if holes.any() else shapely.get_exterior_ring(polygons)
     coords, ring_of = shapely.get_coordinates(rings, return_index=True)
-    # a shapely ring repeats its first vertex at the end: drop that copy
-    closed_size = np.bincount(ring_of, minlength=len(rings))
-    last = np.cumsum(closed_size) - 1
-    is_open = np.ones(len(coords), dtype=bool)
-    is_open[last] = False
-    pts, ring = coords[is_open], ring_of[is_open]
-    # in the open numbering, ring r ends at last[r] - r and starts size[r] - 1 before
-    end = last - np.arange(len(rings)) - 1
-    nxt = np.arange(1, len(pts) + 1)
-    nxt[end] = end - closed_size + 2
-    succ = pts[nxt]
-    mid = 0.5 * (pts + succ)
-    keep = (pts != succ).any(axis=1)
-    edge = np.flatnonzero(keep)
+    pts, segs, edge, mid, ring, removed = ring_chains(coords, ring_of, len(rings))
     ring_names = _ring_names(names, holes.tolist())
-    segs = np.empty((len(edge), 2), dtype=np.int64)
-    segs[:, 0] = np.arange(len(edge))
-    segs[:, 1] = segs[:, 0] + 1
-    if len(edge) == len(pts):  # no repeated vertex: the rings as they are
-        segs[end, 1] = nxt[end]
-        return pts, segs, edge, ring, mid, ring_names
-    removed = np.bincount(ring, minlength=len(rings)) - np.bincount(
-        ring[edge], minlength=len(rings)
-    )
     for r in np.flatnonzero(removed).tolist():
         note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
-    kept_end = np.cumsum(closed_size - 1 - removed) - 1
-    segs[kept_end, 1] = kept_end - (closed_size - 1 - removed) + 1
-    return pts[keep], segs, edge, ring, mid, ring_names
+    return pts, segs, edge, ring, mid, ring_names
 
 
 def _ring_names(names: list[str], holes: list[int]) -> list[str]:
