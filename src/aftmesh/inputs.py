@@ -88,6 +88,8 @@ def _with_lines(rings: tuple, lines: list, line_names: list[str], points: list):
     """The rings' arrays (see _ring_arrays) with the constraint lines' vertices,
     segments and input edges appended, then the fixed points' vertices."""
     verts, segs, edges, source, mids, names = rings
+    if not lines and not points:
+        return verts, segs, edges, source, mids, list(names)
     verts, segs, edges, source, mids = [verts], [segs], [edges], [source], [mids]
     n_vertices, n_edges = len(verts[0]), len(mids[0])
     for line, name in zip(lines, line_names):
