@@ -188,7 +188,14 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
     # copy), so it is not computed: check_polygon's validity holds for what is meshed
     valid = len(polygons) == 1
-    union = polygons[0] if valid else shapely.union_all(polygons)
+    if valid:
+        union = polygons[0]
+    elif not lines and not points and shapely.is_valid(multi := MultiPolygon(polygons)):
+        # parts that meet at points only: their union (an overlay, ten times the cost
+        # of this check on real data) is those parts again, and only its area is used
+        union = multi
+    else:
+        union = shapely.union_all(polygons)
     check_lines_inside(polygons, lines, line_names, points, tolerance, union)
     if isinstance(union, Polygon):
         polygons, names = [union], ["the polygon"]
