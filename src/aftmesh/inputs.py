@@ -121,7 +121,8 @@ def _from_shapely(
     area: float | None = None,
 ) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain.
-    `valid`: the one polygon is known valid (so its rings cannot cross); `area`: the
+    `valid`: the polygons are known valid, one polygon or the parts of a valid
+    multipolygon (so their rings cannot cross); `area`: the
     area of the polygons' union."""
     note: list[str] = []
     rings = _ring_arrays(polygons, names, note)
@@ -131,7 +132,7 @@ def _from_shapely(
     is_ring = edge_source < n_rings
     report: dict = {}
     valid_rings = 0
-    if valid and len(polygons) == 1 and not lines and not points:
+    if valid and not lines and not points:
         valid_rings = len(source_names)
     verts, segs, edges = merge_and_node(
         verts, segs, edges, note, is_ring, tolerance, report, valid_rings
@@ -193,7 +194,7 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     elif not lines and not points and shapely.is_valid(multi := MultiPolygon(polygons)):
         # parts that meet at points only: their union (an overlay, ten times the cost
         # of this check on real data) is those parts again, and only its area is used
-        union = multi
+        union, valid = multi, True
     else:
         union = shapely.union_all(polygons)
     check_lines_inside(polygons, lines, line_names, points, tolerance, union)

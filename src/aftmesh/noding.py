@@ -73,12 +73,12 @@ def merge_and_node(
     :func:`merge_close`) and a line's free end or bend that near a segment splits it
     there; ``report`` then receives the counts ``merged`` and ``snapped``.
 
-    `valid_rings` > 0 says the segments are exactly the rings of one polygon that
-    shapely found valid, that many rings: then no two segments cross (validity
-    forbids it, decided with exact predicates as the crossing search would), so the
-    search is skipped; with one ring, no vertex lies on another segment either (the
-    ring is simple, and a ring's vertex is never snapped), so the split is skipped,
-    and so is the search for repeated segments."""
+    `valid_rings` > 0 says the segments are exactly the rings of one polygon (or of
+    the parts of one multipolygon) that shapely found valid, that many rings: then
+    no two segments cross (validity forbids it, decided with exact predicates as the
+    crossing search would), so the search is skipped; with one ring, no vertex lies
+    on another segment either (the ring is simple, and a ring's vertex is never
+    snapped), so the split is skipped, and so is the search for repeated segments."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
