@@ -122,8 +122,7 @@ def _from_shapely(
 ) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain.
     `valid`: the polygons are known valid, one polygon or the parts of a valid
-    multipolygon (so their rings cannot cross); `area`: the
-    area of the polygons' union."""
+    multipolygon (so their rings cannot cross); `area`: the area of their union."""
     note: list[str] = []
     rings = _ring_arrays(polygons, names, note)
     n_rings = len(rings[5])
