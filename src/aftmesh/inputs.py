@@ -60,7 +60,9 @@ def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
     # get_rings is several times slower than taking the exterior rings when that is all
     rings = shapely.get_rings(polygons) if holes.any() else shapely.get_exterior_ring(polygons)
     coords, ring_of = shapely.get_coordinates(rings, return_index=True)
-    pts, segs, edge, mid, ring, removed = ring_chains(coords, ring_of, len(rings))
+    pts, segs, edge, mid, ring, removed = ring_chains(
+        coords, ring_of.astype(np.int64, copy=False), len(rings)
+    )
     ring_names = _ring_names(names, holes.tolist())
     for r in np.flatnonzero(removed).tolist():
         note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
