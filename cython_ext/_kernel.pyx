@@ -16,6 +16,7 @@ hold the ``nogil`` kernels:
 * smoothing.pxi      smoothing after the front closes, with Delaunay flips
 * optimize.pxi       one smoothing move: the best candidate place of a vertex
 * refine.pxi         the minimum-angle pass (Delaunay refinement)
+* inputs.pxi         ring clean-up, coordinate and segment checks of the input
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -50,6 +51,7 @@ include "front.pxi"
 include "smoothing.pxi"
 include "optimize.pxi"
 include "refine.pxi"
+include "inputs.pxi"
 
 
 class KernelError(RuntimeError):
@@ -774,3 +776,55 @@ def limit_gradation_mesh(const double[:, ::1] xy, const int32_t[:, ::1] tv, doub
         res = limit_gradation_graph(nv, &start[0], &adj[0], &xy[0, 0], &h[0], rate, reach)
     if res:
         raise MemoryError()
+
+
+def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t n_rings):
+    """Rings as closed coordinate runs (shapely's get_coordinates with return_index)
+    -> (vertices (k, 2), segments (k, 2) int64, input edge of each vertex (k,),
+    midpoint (e, 2) and ring (e,) of each input edge, repeats removed per ring); see
+    ring_chains_into in inputs.pxi."""
+    cdef Py_ssize_t n = xy.shape[0], k
+    if ring_of.shape[0] != n:
+        raise ValueError("xy and ring_of differ in length")
+    # every ring has a coordinate, so the open vertices number exactly n - n_rings
+    cdef bint ok = (ring_of[0] == 0 and ring_of[n - 1] == n_rings - 1) if n else n_rings == 0
+    for k in range(1, n):
+        ok = ok and 0 <= ring_of[k] - ring_of[k - 1] <= 1
+    if not ok:
+        raise ValueError("ring numbers must run from 0 to n_rings - 1 in steps of 0 or 1")
+    cdef Py_ssize_t n_open = n - n_rings
+    mid_arr = np.empty((n_open, 2), dtype=np.float64)
+    ring_arr = np.empty(n_open, dtype=np.int64)
+    pts_arr = np.empty((n_open, 2), dtype=np.float64)
+    edge_arr = np.empty(n_open, dtype=np.int64)
+    seg_arr = np.empty((n_open, 2), dtype=np.int64)
+    removed_arr = np.zeros(n_rings, dtype=np.int64)
+    cdef double[:, ::1] mid = mid_arr, pts = pts_arr
+    cdef int64_t[::1] ring = ring_arr, edge = edge_arr, removed = removed_arr
+    cdef int64_t[:, ::1] seg = seg_arr
+    if n_open:
+        with nogil:
+            k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
+                                 &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
+    else:
+        k = 0
+    return pts_arr[:k], seg_arr[:k], edge_arr[:k], mid_arr, ring_arr, removed_arr
+
+
+def coordinate_problems(const double[:, ::1] xy, double lo, double hi):
+    """Bits: 1 a non-finite coordinate, 2 one of magnitude above hi, 4 one nonzero of
+    magnitude below lo (see coordinate_flags in inputs.pxi)."""
+    if xy.shape[0] == 0:
+        return 0
+    return coordinate_flags(&xy[0, 0], xy.shape[0] * xy.shape[1], lo, hi)
+
+
+def segment_problems(const int64_t[:, ::1] seg, const double[:, ::1] xy):
+    """Bits: 1 an index outside the points, 2 a segment of zero length (see
+    segment_flags in inputs.pxi)."""
+    if seg.shape[1] != 2 or xy.shape[1] != 2:
+        raise ValueError("segments and points must have two columns")
+    if seg.shape[0] == 0:
+        return 0
+    return segment_flags(&seg[0, 0], seg.shape[0], xy.shape[0],
+                         &xy[0, 0] if xy.shape[0] else NULL)

@@ -13,16 +13,41 @@ import numpy as np
 
 from ._kernel import hilbert_keys
 
+# The default seed of the random rounds.
+SEED = 20231121
+# The round keys of the first this many points under SEED are kept after the first
+# call: drawing them costs more than the rest of ordering a small input.
+CACHED_ROUNDS = 4096
+_cached_rounds: np.ndarray | None = None
 
-def brio_order(xy: np.ndarray, seed: int = 20231121) -> np.ndarray:
-    """Indices of `xy` in BRIO order: rounds of doubling size, Hilbert-sorted within."""
-    n = len(xy)
-    if n == 0:
-        return np.zeros(0, dtype=np.int32)
+
+def _round_keys(n: int, seed: int) -> np.ndarray:
+    """The high bits of each point's key: its BRIO round, later rounds first.  A
+    generator's first n draws do not depend on how many more are drawn after them,
+    so the cached keys of the default seed are a prefix of any longer draw."""
+    global _cached_rounds
+    if seed == SEED and n <= CACHED_ROUNDS:
+        if _cached_rounds is None:  # two threads may both draw it: the same keys
+            keys = _draw_round_keys(CACHED_ROUNDS, seed)
+            keys.setflags(write=False)
+            _cached_rounds = keys
+        return _cached_rounds[:n]
+    return _draw_round_keys(n, seed)
+
+
+def _draw_round_keys(n: int, seed: int) -> np.ndarray:
     rng = np.random.default_rng(seed)
     # round k (k = 0 is the last, largest one) holds about n / 2**(k+1) points
     u = rng.random(n)
     rounds = np.minimum(np.floor(-np.log2(np.maximum(u, 1e-300))), 62).astype(np.int64)
     # one int64 key: the round in the high bits (later rounds first), the curve below
-    keys = ((62 - rounds) << 32) | hilbert_keys(np.ascontiguousarray(xy, dtype=np.float64))
+    return (62 - rounds) << 32
+
+
+def brio_order(xy: np.ndarray, seed: int = SEED) -> np.ndarray:
+    """Indices of `xy` in BRIO order: rounds of doubling size, Hilbert-sorted within."""
+    n = len(xy)
+    if n == 0:
+        return np.zeros(0, dtype=np.int32)
+    keys = _round_keys(n, seed) | hilbert_keys(np.ascontiguousarray(xy, dtype=np.float64))
     return np.argsort(keys, kind="stable").astype(np.int32)

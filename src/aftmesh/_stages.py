@@ -279,6 +279,15 @@ def refine(kernel, dom: Domain, opts: Options) -> dict | None:
     return {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
 
 
+def _lookup(table: np.ndarray, index: np.ndarray) -> np.ndarray:
+    """table[index] as int32, -1 where index is -1 (the kernel's and the domain's
+    "none"; no index is below that)."""
+    out = np.empty(len(table) + 1, dtype=np.int32)
+    out[:-1] = table
+    out[-1] = -1
+    return out[index]
+
+
 def assemble(
     kernel,
     boundary: Boundary,
@@ -296,10 +305,10 @@ def assemble(
     built = boundary.built
     a = kernel.arrays()
     pieces = a["segment_ids"]  # the kernel's provenance of each output segment
-    edges = np.where(pieces >= 0, boundary.source[np.maximum(pieces, 0)], -1).astype(np.int32)
-    markers = np.where(edges >= 0, dom.edge_source[np.maximum(edges, 0)], -1).astype(np.int32)
+    edges = _lookup(boundary.source, pieces)
+    markers = _lookup(dom.edge_source, edges)
     if dom.source_markers is not None:
-        markers = np.where(markers >= 0, dom.source_markers[np.maximum(markers, 0)], -1)
+        markers = _lookup(dom.source_markers, markers)
     counters = kernel.counters()
     info = {
         "merged_vertices": built.n_merged,

@@ -27,6 +27,7 @@ from shapely.geometry import (
     Polygon,
 )
 
+from ._kernel import ring_chains
 from ._typing import DomainArg
 from .domain_record import Domain
 from .errors import InvalidDomainError
@@ -43,69 +44,37 @@ __all__ = ["Domain", "to_domain"]
 REGION_OVERLAP = 1e-12
 
 
-class _Chains:
-    """Rings and lines gathered as vertices and numbered input edges."""
+def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
+    """Every ring of the polygons at once (each polygon's exterior ring, then its
+    holes): its distinct vertices in order, each with its outgoing input edge.  A run
+    of repeated vertices is kept once, as its last copy, whose outgoing edge is the
+    one that leaves the run.  Vertices on a straight run of a ring stay: users put
+    them there on purpose (a load point, a sensor, where a boundary condition
+    changes); near-coincident ones are merged by the tolerance instead.
 
-    def __init__(self):
-        self.vertices: list[np.ndarray] = []
-        self.segments: list[np.ndarray] = []
-        self.edge_ids: list[np.ndarray] = []
-        self.edge_source: list[np.ndarray] = []
-        self.midpoints: list[np.ndarray] = []
-        self.names: list[str] = []
-        self.is_ring: list[bool] = []
-        self.n_vertices = 0
-        self.n_edges = 0
-
-    def add(
-        self,
-        coords: np.ndarray,
-        edge_ids: np.ndarray,
-        n_edges: int,
-        closed: bool,
-        name: str,
-        midpoints: np.ndarray,
-    ) -> None:
-        """Add one ring or line: `coords` cleaned, `edge_ids[i]` the input edge (within
-        this chain, of `n_edges`) from coords[i] to the next vertex."""
-        n = len(coords)
-        source = len(self.names)
-        self.names.append(name)
-        self.is_ring.append(closed)
-        self.edge_source.append(np.full(n_edges, source))
-        self.midpoints.append(midpoints)
-        if n >= 2:
-            idx = np.arange(n)
-            seg = np.c_[idx, (idx + 1) % n] if closed else np.c_[idx[:-1], idx[1:]]
-            self.vertices.append(coords)
-            self.segments.append(seg + self.n_vertices)
-            self.edge_ids.append(np.asarray(edge_ids[: len(seg)]) + self.n_edges)
-            self.n_vertices += n
-        self.n_edges += n_edges
-
-    def add_points(self, pts: np.ndarray) -> None:
-        self.vertices.append(pts)
-        self.n_vertices += len(pts)
+    The polygons passed check_polygon, so each ring has at least three distinct
+    vertices.  Returns (vertices, segments, input edge of each segment, ring of each
+    input edge, midpoint of each input edge, ring names); a ring of n vertices
+    (closing one not counted) has n input edges, numbered on from the ring before."""
+    holes = shapely.get_num_interior_rings(polygons)
+    # get_rings is several times slower than taking the exterior rings when that is all
+    rings = shapely.get_rings(polygons) if holes.any() else shapely.get_exterior_ring(polygons)
+    coords, ring_of = shapely.get_coordinates(rings, return_index=True)
+    pts, segs, edge, mid, ring, removed = ring_chains(
+        coords, ring_of.astype(np.int64, copy=False), len(rings)
+    )
+    ring_names = _ring_names(names, holes.tolist())
+    for r in np.flatnonzero(removed).tolist():
+        note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
+    return pts, segs, edge, ring, mid, ring_names
 
 
-def _ring_chain(coords: np.ndarray, note: list[str], name: str):
-    """A ring's distinct vertices in order, each with the index of its outgoing input
-    edge: a run of repeated vertices is kept once, as its last copy, whose outgoing
-    edge is the one that leaves the run.  Vertices on a straight run of the ring stay:
-    users put them there on purpose (a load point, a sensor, where a boundary
-    condition changes); near-coincident ones are merged by the tolerance instead."""
-    c = np.asarray(coords, dtype=np.float64)
-    closed = len(c) > 1 and (c[0] == c[-1]).all()
-    n = len(c) - 1 if closed else len(c)
-    open_c = c[:n]
-    keep = (open_c != np.roll(open_c, -1, axis=0)).any(axis=1) if n > 1 else np.ones(n, bool)
-    if n > 1 and not keep.any():
-        keep[-1] = True
-    if int(n - keep.sum()):
-        note.append(f"{name}: removed {int(n - keep.sum())} repeated vertices")
-    ids = np.flatnonzero(keep)
-    mid = 0.5 * (open_c + np.roll(open_c, -1, axis=0))
-    return open_c[keep], ids, n, mid
+def _ring_names(names: list[str], holes: list[int]) -> list[str]:
+    out = []
+    for name, n in zip(names, holes):
+        out.append(f"{name}, exterior ring")
+        out.extend(f"{name}, hole {i}" for i in range(n))
+    return out
 
 
 def _line_chain(coords: np.ndarray):
@@ -117,6 +86,32 @@ def _line_chain(coords: np.ndarray):
     return c[keep], np.flatnonzero(keep), max(len(c) - 1, 0), mid
 
 
+def _with_lines(rings: tuple, lines: list, line_names: list[str], points: list):
+    """The rings' arrays (see _ring_arrays) with the constraint lines' vertices,
+    segments and input edges appended, then the fixed points' vertices."""
+    verts, segs, edges, source, mids, names = rings
+    if not lines and not points:
+        return verts, segs, edges, source, mids, list(names)
+    verts, segs, edges, source, mids = [verts], [segs], [edges], [source], [mids]
+    n_vertices, n_edges = len(verts[0]), len(mids[0])
+    for line, name in zip(lines, line_names):
+        c, ids, n, mid = _line_chain(np.asarray(line.coords)[:, :2])
+        source.append(np.full(n, len(names)))
+        names.append(name)
+        mids.append(mid)
+        if len(c) >= 2:
+            idx = np.arange(len(c))
+            verts.append(c)
+            segs.append(np.c_[idx[:-1], idx[1:]] + n_vertices)
+            edges.append(ids[: len(c) - 1] + n_edges)
+            n_vertices += len(c)
+        n_edges += n
+    if points:
+        verts.append(np.concatenate([np.asarray(p.coords)[:, :2] for p in points]))
+    cat = np.concatenate
+    return cat(verts), cat(segs), cat(edges), cat(source), cat(mids), names
+
+
 def _from_shapely(
     polygons: list[Polygon],
     lines: list,
@@ -125,49 +120,33 @@ def _from_shapely(
     names: list[str],
     tolerance: float = 0.0,
     valid: bool = False,
+    area: float | None = None,
 ) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain.
-    `valid`: the one polygon is known valid (so its rings cannot cross)."""
+    `valid`: the polygons are known valid, one polygon or the parts of a valid
+    multipolygon (so their rings cannot cross); `area`: the area of their union."""
     note: list[str] = []
-    chains = _Chains()
-    for k, poly in enumerate(polygons):
-        rings = [("exterior ring", poly.exterior)] + [
-            (f"hole {i}", h) for i, h in enumerate(poly.interiors)
-        ]
-        for rname, ring in rings:
-            name = f"{names[k]}, {rname}"
-            c, ids, n_edges, mid = _ring_chain(np.asarray(ring.coords)[:, :2], note, name)
-            chains.add(c, ids, n_edges, True, name, mid)
-    for line, name in zip(lines, line_names):
-        c, ids, n_edges, mid = _line_chain(np.asarray(line.coords)[:, :2])
-        chains.add(c, ids, n_edges, False, name, mid)
-    if points:
-        chains.add_points(np.concatenate([np.asarray(p.coords)[:, :2] for p in points]))
-    verts = np.concatenate(chains.vertices) if chains.vertices else np.zeros((0, 2))
-    segs = np.concatenate(chains.segments) if chains.segments else np.zeros((0, 2), np.int64)
-    edges = np.concatenate(chains.edge_ids) if chains.edge_ids else np.zeros(0, np.int64)
-    edge_source = (
-        np.concatenate(chains.edge_source) if chains.edge_source else np.zeros(0, np.int64)
-    ).astype(np.int32)
-    is_ring = np.asarray(chains.is_ring, dtype=bool)[edge_source]
+    rings = _ring_arrays(polygons, names, note)
+    n_rings = len(rings[5])
+    verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
+    edge_source = source.astype(np.int32)
+    is_ring = edge_source < n_rings
     report: dict = {}
     valid_rings = 0
-    if valid and len(polygons) == 1 and not lines and not points:
-        valid_rings = len(chains.names)
+    if valid and not lines and not points:
+        valid_rings = len(source_names)
     verts, segs, edges = merge_and_node(
         verts, segs, edges, note, is_ring, tolerance, report, valid_rings
     )
-    union_area = float(shapely.union_all(polygons).area)
-    mids = np.concatenate(chains.midpoints) if chains.midpoints else np.zeros((0, 2))
     return Domain(
         verts,
         segs.astype(np.int32),
         edges.astype(np.int32),
         edge_source,
-        chains.names,
+        source_names,
         edge_is_ring=is_ring,
         polygons=polygons,
-        area=union_area,
+        area=area,
         cleanup=note,
         edge_midpoints=mids,
         report={"tolerance": report} if report else {},
@@ -208,15 +187,22 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     names = [f"polygon {k}" if len(polygons) > 1 else "the polygon" for k in range(len(polygons))]
     for k, p in enumerate(polygons):
         check_polygon(p, names[k])
-    check_lines_inside(polygons, lines, line_names, points, tolerance)
-    checked = polygons[0] if len(polygons) == 1 else None
-    single = shapely.union_all(polygons)
-    if isinstance(single, Polygon):
-        polygons, names = [single], ["the polygon"]
-    # the union of one polygon is that polygon, vertex for vertex, in practice: then
-    # check_polygon's validity holds for what is meshed
-    valid = checked is not None and bool(shapely.equals_exact(polygons[0], checked, 0.0))
-    return _from_shapely(polygons, lines, line_names, points, names, tolerance, valid)
+    # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
+    # copy), so it is not computed: check_polygon's validity holds for what is meshed
+    valid = len(polygons) == 1
+    if valid:
+        union = polygons[0]
+    elif not lines and not points and shapely.is_valid(multi := MultiPolygon(polygons)):
+        # parts that meet at points only: their union (an overlay, ten times the cost
+        # of this check on real data) is those parts again, and only its area is used
+        union, valid = multi, True
+    else:
+        union = shapely.union_all(polygons)
+    check_lines_inside(polygons, lines, line_names, points, tolerance, union)
+    if isinstance(union, Polygon):
+        polygons, names = [union], ["the polygon"]
+    area = float(union.area)
+    return _from_shapely(polygons, lines, line_names, points, names, tolerance, valid, area)
 
 
 def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:
@@ -232,7 +218,9 @@ def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:
     except (ValueError, TypeError) as exc:
         raise InvalidDomainError(f"the ring is not a polygon: {exc}") from None
     check_polygon(poly, "the polygon")
-    return _from_shapely([poly], [], [], [], ["the polygon"], tolerance, valid=True)
+    return _from_shapely(
+        [poly], [], [], [], ["the polygon"], tolerance, valid=True, area=float(poly.area)
+    )
 
 
 def _region_polygon(k: int, item):
@@ -270,9 +258,10 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
         for part in polygon_parts(p, f"region {k}"):
             flat.append(part)
             names.append(f"region {k}")
-    dom = _from_shapely(flat, [], [], [], names, tolerance)
+    dom = _from_shapely(
+        flat, [], [], [], names, tolerance, area=float(sum(p.area for p in polygons))
+    )
     dom.polygons = polygons
-    dom.area = float(sum(p.area for p in polygons))
     return dom
 
 

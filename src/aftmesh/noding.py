@@ -74,30 +74,59 @@ def merge_and_node(
     :func:`merge_close`) and a line's free end or bend that near a segment splits it
     there; ``report`` then receives the counts ``merged`` and ``snapped``.
 
-    `valid_rings` > 0 says the segments are exactly the rings of one polygon that
-    shapely found valid, that many rings: then no two segments cross (validity
-    forbids it, decided with exact predicates as the crossing search would), so the
-    search is skipped; with one ring, no vertex lies on another segment either (the
-    ring is simple, and a ring's vertex is never snapped), so the split is skipped."""
+    `valid_rings` > 0 says the segments are exactly the rings of one polygon (or of
+    the parts of one multipolygon) that shapely found valid, that many rings: then
+    no two segments cross (validity forbids it, decided with exact predicates as the
+    crossing search would), so the search is skipped; with one ring, no vertex lies
+    on another segment either (the ring is simple, and a ring's vertex is never
+    snapped), so the split is skipped, and so is the search for repeated segments."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
         if n_merged:
             note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
-    uniq, inverse = np.unique(verts, axis=0, return_inverse=True)
-    segs = inverse.reshape(-1)[segs]
+    uniq, inverse = unique_rows(verts)
+    segs = inverse[segs]
+    exact_valid = valid_rings and not tolerance > 0
+    if exact_valid and valid_rings == 1:
+        # one simple ring of at least three distinct vertices: no vertex on another
+        # segment, no segment given twice or from a vertex to itself, no crossing
+        return uniq, segs, src
     tol = max(snap_tolerance(uniq), tolerance)
     counts = {"snapped": 0}
-    if valid_rings != 1 or tolerance > 0:
-        segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
+    segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    if valid_rings and not tolerance > 0:
+    if exact_valid:
         out = uniq, segs, src
     else:
         out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
     if report is not None and tolerance > 0:
         report.update(merged=n_merged, snapped=counts["snapped"])
     return out
+
+
+def unique_rows(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(pts, axis=0, return_inverse=True)`` (the distinct points in
+    lexicographic order, and each point's index among them) from one lexicographic
+    sort, without np.unique's cost.  Finite points only; and where two copies of a
+    point differ in their bits (0.0 and -0.0) np.unique itself decides which is kept."""
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    srt = pts[order]
+    same = (srt[1:] == srt[:-1]).all(axis=1)
+    inverse = np.empty(len(pts), dtype=np.intp)
+    if not same.any():
+        if np.isfinite(srt).all():
+            inverse[order] = np.arange(len(pts))
+            return srt, inverse
+    elif np.isfinite(srt).all():
+        bits = srt.view(np.int64)
+        if (bits[1:][same] == bits[:-1][same]).all():
+            first = np.ones(len(pts), dtype=bool)
+            first[1:] = ~same
+            inverse[order] = np.cumsum(first) - 1
+            return srt[first], inverse
+    uniq, inv = np.unique(pts, axis=0, return_inverse=True)
+    return uniq, inv.reshape(-1)
 
 
 def merge_close(verts: np.ndarray, tolerance: float) -> tuple[np.ndarray, int]:
@@ -137,8 +166,8 @@ def merge_close_segments(
     if not n_merged:
         return pts, segs, src, 0
     note.append(f"merged {n_merged} vertices within tolerance {tolerance:g} of another")
-    uniq, inverse = np.unique(moved, axis=0, return_inverse=True)
-    segs, src = _drop_repeats(inverse.reshape(-1)[segs], np.asarray(src))
+    uniq, inverse = unique_rows(moved)
+    segs, src = _drop_repeats(inverse[segs], np.asarray(src))
     return uniq, segs, src, n_merged
 
 
@@ -219,8 +248,8 @@ def node_crossings(
         n_cut += pairs.shape[1]
         verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
         segs, src = _cut(verts, segs, src, cuts)
-        verts, inverse = np.unique(verts, axis=0, return_inverse=True)
-        segs = inverse.reshape(-1)[segs]
+        verts, inverse = unique_rows(verts)
+        segs = inverse[segs]
         segs, src = split_at_vertices(verts, segs, src, None, tol, ring_source)
         segs, src = _drop_repeats(segs, src)
     if n_cut and note is not None:
@@ -258,9 +287,13 @@ def _cut(pts, segs, src, cuts):
 
 
 def _drop_repeats(segs, src):
+    """The segments without those given twice (either way round; the first copy
+    stays) and without those from a vertex to itself, in input order."""
     key = np.sort(segs, axis=1)
     keep = key[:, 0] != key[:, 1]
-    _, first = np.unique(key, axis=0, return_index=True)
+    # one integer per vertex pair, ordered as the pairs are (indices are below 2**31)
+    pair = key[:, 0].astype(np.int64) * (int(key[:, 1].max(initial=0)) + 1) + key[:, 1]
+    _, first = np.unique(pair, return_index=True)
     first = np.sort(first[keep[first]])
     return segs[first], src[first]
 

@@ -6,6 +6,7 @@ any geometry is touched; the stages after this read a frozen :class:`Options`.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -81,7 +82,7 @@ def real(name: str, value: Any, error: type[ValueError] = InvalidOptionError) ->
         out = float(value)
     except (TypeError, ValueError):
         raise error(f"{name} must be a number, got {value!r}") from None
-    if not np.isfinite(out):
+    if not math.isfinite(out):
         raise error(f"{name} must be finite, got {value!r}")
     return out
 

@@ -29,6 +29,9 @@ from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 # these bounds (beyond, intermediate products could overflow or underflow; see
 # cython_ext/predicates.pxi): other coordinates are refused with a message saying so.
 MIN_COORDINATE, MAX_COORDINATE = _kernel.EXACT_COORDINATE_RANGE
+# The bits of _kernel.coordinate_problems and _kernel.segment_problems.
+COORDINATE_NOT_FINITE = 1
+SEGMENT_OUT_OF_RANGE, SEGMENT_ZERO_LENGTH = 1, 2
 
 
 @dataclass
@@ -51,16 +54,25 @@ def as_points(value: npt.ArrayLike | None, name: str) -> np.ndarray:
         return np.zeros((0, 2), dtype=np.float64)
     if arr.ndim != 2 or arr.shape[1] != 2:
         raise InvalidInputError(f"{name} must have shape (n, 2), got {arr.shape}")
-    bad = ~np.isfinite(arr).all(axis=1)
-    if bad.any():
-        i = int(np.flatnonzero(bad)[0])
+    arr = np.ascontiguousarray(arr)
+    # one compiled pass for the usual case; the row at fault is found only if needed
+    problems = _kernel.coordinate_problems(arr, MIN_COORDINATE, MAX_COORDINATE)
+    if problems & COORDINATE_NOT_FINITE:
+        i = int(np.flatnonzero(~np.isfinite(arr).all(axis=1))[0])
         raise InvalidInputError(f"{name}[{i}] = {arr[i].tolist()} is not finite")
-    check_range(arr, name)
-    return np.ascontiguousarray(arr)
+    if problems:
+        check_range(arr, name)
+    return arr
 
 
 def check_range(arr: np.ndarray, name: str) -> None:
     """Refuse coordinates outside the exact predicates' range (see MAX_COORDINATE)."""
+    arr = np.ascontiguousarray(arr, dtype=np.float64)
+    if (
+        not _kernel.coordinate_problems(arr, MIN_COORDINATE, MAX_COORDINATE)
+        & ~COORDINATE_NOT_FINITE
+    ):
+        return
     mag = np.abs(arr)
     big = (mag > MAX_COORDINATE).any(axis=1)
     if big.any():
@@ -96,14 +108,17 @@ def as_segments(value: npt.ArrayLike | None, n_vertices: int, vertices: np.ndarr
             raise InvalidInputError("segments must hold integer vertex indices")
         raw = as_int
     seg = raw.astype(np.int64)
-    bad = (seg < 0) | (seg >= n_vertices)
-    if bad.any():
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
+    # one compiled pass for the usual case; the segment at fault only if needed
+    problems = _kernel.segment_problems(seg, vertices[:n_vertices])
+    if problems & SEGMENT_OUT_OF_RANGE:
+        bad = (seg < 0) | (seg >= n_vertices)
         i = int(np.flatnonzero(bad.any(axis=1))[0])
         raise InvalidInputError(
             f"segments[{i}] = {seg[i].tolist()} refers to a vertex outside 0..{n_vertices - 1}"
         )
-    zero = (seg[:, 0] == seg[:, 1]) | (vertices[seg[:, 0]] == vertices[seg[:, 1]]).all(axis=1)
-    if zero.any():
+    if problems & SEGMENT_ZERO_LENGTH:
+        zero = (seg[:, 0] == seg[:, 1]) | (vertices[seg[:, 0]] == vertices[seg[:, 1]]).all(axis=1)
         i = int(np.flatnonzero(zero)[0])
         raise InvalidInputError(
             f"segments[{i}] = {seg[i].tolist()} has zero length "

@@ -30,9 +30,10 @@ def classify_pieces(
     for k, poly in enumerate(polygons):
         inside = shapely.contains_xy(poly, probes[:, 0], probes[:, 1])
         region_of[inside & (region_of < 0)] = k
-    for c in range(len(probes)):
-        (ax, ay), (bx, by), (cx, cy) = corners[c]
-        x, y = probes[c]
+    # Python floats: the same doubles, without a numpy scalar per coordinate
+    for c, (((ax, ay), (bx, by), (cx, cy)), (x, y)) in enumerate(
+        zip(corners.tolist(), probes.tolist())
+    ):
         side = py_orient2d(ax, ay, bx, by, cx, cy)
         if (
             side != 0

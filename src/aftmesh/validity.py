@@ -34,6 +34,10 @@ def validity_reason(geom: shapely.Geometry) -> str:
 
 
 def _check_finite(poly: Polygon, where: str) -> None:
+    # one vectorized look at x and y first; the rings one by one (and z) only when
+    # that finds a problem or there is more than x and y to look at
+    if not (poly.has_z or poly.has_m) and np.isfinite(shapely.get_coordinates(poly)).all():
+        return
     for k, ring in enumerate([poly.exterior, *poly.interiors]):
         c = np.asarray(ring.coords)
         bad = ~np.isfinite(c).all(axis=1)
@@ -135,10 +139,15 @@ def check_lines_inside(
     line_names: Sequence[str],
     points: Sequence[shapely.Point],
     tolerance: float = 0.0,
+    union: shapely.Geometry | None = None,
 ) -> None:
     """Refuse constraint lines or fixed points outside the domain (a line may stick
-    out by rounding only, see :func:`_outside_by_rounding`, or by `tolerance`)."""
-    union = shapely.union_all(polygons)
+    out by rounding only, see :func:`_outside_by_rounding`, or by `tolerance`).
+    `union`: the polygons' union, if the caller has it already."""
+    if not lines and not points:
+        return
+    if union is None:
+        union = shapely.union_all(polygons)
     tol = None
     for line, name in zip(lines, line_names):
         if union.covers(line):
