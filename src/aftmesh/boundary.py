@@ -49,23 +49,11 @@ def discretize(
     a = vertices[segments[:, 0]]
     b = vertices[segments[:, 1]]
     length = np.linalg.norm(b - a, axis=1)
-    s = np.linspace(0.0, 1.0, _SAMPLES)
-    xs = a[:, None, 0] + (b - a)[:, None, 0] * s
-    ys = a[:, None, 1] + (b - a)[:, None, 1] * s
-    h = field(xs, ys)
-    # cumulative integral of 1/h along each segment, h taken linear between samples:
-    # the exact integral of 1/h on such a piece is ds * ln(h1/h0) / (h1 - h0) (the
-    # trapezoid rule overcounts enormously next to a tiny size, where h varies by
-    # orders of magnitude within one sample interval)
-    ds = length[:, None] / (_SAMPLES - 1)
-    h0 = h[:, :-1]
-    h1 = h[:, 1:]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_mean = np.where(
-            np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0), 2.0 / (h0 + h1)
-        )
-    steps = ds * log_mean
-    cum = np.concatenate([np.zeros((len(segments), 1)), np.cumsum(steps, axis=1)], axis=1)
+    if field.is_constant:
+        cum = (length / field.constant)[:, None] * np.array([0.0, 1.0])
+        s = np.array([0.0, 1.0])  # the integral of 1/h is linear: its two ends say it all
+    else:
+        cum, s = _integral_of_inverse_size(a, b, length, field)
     total = float(np.rint(cum[:, -1]).clip(min=1).sum())
     if max_pieces is not None and not total <= max_pieces:
         from .errors import InvalidSizeError
@@ -90,6 +78,29 @@ def discretize(
         row = np.repeat(split, counts)
         pts = np.concatenate(points) if len(points) else pts
     return _chains(vertices, segments, source, pieces == 1, split, row, counts, pts, a, b)
+
+
+def _integral_of_inverse_size(a, b, length, field):
+    """The cumulative integral of 1/h along each segment at _SAMPLES points, and the
+    points' parameters along the segments."""
+    s = np.linspace(0.0, 1.0, _SAMPLES)
+    xs = a[:, None, 0] + (b - a)[:, None, 0] * s
+    ys = a[:, None, 1] + (b - a)[:, None, 1] * s
+    h = field(xs, ys)
+    # cumulative integral of 1/h along each segment, h taken linear between samples:
+    # the exact integral of 1/h on such a piece is ds * ln(h1/h0) / (h1 - h0) (the
+    # trapezoid rule overcounts enormously next to a tiny size, where h varies by
+    # orders of magnitude within one sample interval)
+    ds = length[:, None] / (_SAMPLES - 1)
+    h0 = h[:, :-1]
+    h1 = h[:, 1:]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log_mean = np.where(
+            np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0), 2.0 / (h0 + h1)
+        )
+    steps = ds * log_mean
+    cum = np.concatenate([np.zeros((len(a), 1)), np.cumsum(steps, axis=1)], axis=1)
+    return cum, s
 
 
 def _interp_rows(x: np.ndarray, cum: np.ndarray, row: np.ndarray, s: np.ndarray) -> np.ndarray:

@@ -323,6 +323,10 @@ def make_size_field(
     """
     if gradation is None or not np.isfinite(gradation) or gradation < 1.0:
         raise InvalidSizeError(f"gradation must be a finite number >= 1, got {gradation!r}")
+    if isinstance(size, SizeField):
+        # a field made before (a partitioned mesh's parts share the whole domain's):
+        # it already holds the boundary's sizes and the gradation
+        return size
     constant = _parse_size(size)
     if constant is not None:
         _check_resolution(np.array([constant]), None, None, bounds, "size")
