@@ -16,8 +16,8 @@ from hypothesis import strategies as st
 from shapely.geometry import GeometryCollection, LineString, MultiPolygon, Point, Polygon, box
 
 import aftmesh
-from aftmesh.sizing import RESOLVE_ROUNDS
 from aftmesh.checks import check_mesh, count_formula
+from aftmesh.sizing import RESOLVE_ROUNDS
 
 
 def valid(mesh, area, *, edges=None, delaunay=True):

@@ -11,7 +11,6 @@ import aftmesh
 from aftmesh import examples
 from aftmesh.sizing import BOUNDARY_REACH, RESOLVE_EVALUATIONS, make_size_field
 
-
 # triangles per factor e between the chamfer's size and the square's, around one
 # corner: a quarter of the 2 pi / (0.43 rate^2) of a full graded disk (rate 0.3),
 # with a margin
