@@ -10,13 +10,14 @@ hold the ``nogil`` kernels:
 * cdt.pxi            constrained edges (Cline & Renka), with segment provenance
 * domain.pxi         flood fills: carving, regions, the pieces segments separate
 * export.pxi         the domain's triangles as compact arrays
-* sizing.pxi         the compiled size field (background grid), gradation limit
+* sizing.pxi         the compiled size field (background triangulation), gradation limit
 * ordering.pxi       Hilbert curve keys for the insertion order
 * front.pxi          Basic_aft's subtasks on the CDT and the compiled loop
 * smoothing.pxi      smoothing after the front closes, with Delaunay flips
 * optimize.pxi       one smoothing move: the best candidate place of a vertex
 * refine.pxi         the minimum-angle pass (Delaunay refinement)
 * inputs.pxi         ring clean-up, coordinate and segment checks of the input
+* discretize.pxi     input segments split by the integral of 1/size
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -52,6 +53,7 @@ include "smoothing.pxi"
 include "optimize.pxi"
 include "refine.pxi"
 include "inputs.pxi"
+include "discretize.pxi"
 
 
 class KernelError(RuntimeError):
@@ -708,14 +710,10 @@ def incircle_many(const double[:, ::1] points, const int32_t[:, ::1] quad):
     return out_arr
 
 
-def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] w,
-                    const double[::1] g, const int32_t[:, ::1] tv, const int32_t[:, ::1] nb,
-                    double rate, double reach, const double[::1] x, const double[::1] y):
-    """The size field of Triangulation.set_size_field at the points (x[i], y[i])."""
-    cdef SizeField S
-    cdef Py_ssize_t i, n = x.shape[0]
-    out_arr = np.empty(n, dtype=np.float64)
-    cdef double[::1] out = out_arr
+cdef void _borrow_field(SizeField* S, double constant, const double[:, ::1] xy,
+                        const double[::1] w, const double[::1] g, const int32_t[:, ::1] tv,
+                        const int32_t[:, ::1] nb, double rate, double reach) except *:
+    """S reads the given arrays in place (size_at writes nothing but S's hints)."""
     S.constant = constant
     S.rate = rate
     S.reach = reach
@@ -727,18 +725,41 @@ def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] 
     if S.nt:
         if w.shape[0] != S.nv or g.shape[0] != S.nv or nb.shape[0] != S.nt:
             raise ValueError("size field arrays of mismatched lengths")
-        # read only: size_at writes nothing but the hint
         S.xy = <double*> &xy[0, 0]
         S.w = <double*> &w[0]
         S.g = <double*> &g[0]
         S.tv = <int32_t*> &tv[0, 0]
         S.nb = <int32_t*> &nb[0, 0]
+
+
+def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] w,
+                    const double[::1] g, const int32_t[:, ::1] tv, const int32_t[:, ::1] nb,
+                    double rate, double reach, const double[::1] x, const double[::1] y):
+    """The size field of Triangulation.set_size_field at the points (x[i], y[i])."""
+    cdef SizeField S
+    cdef Py_ssize_t i, n = x.shape[0]
+    out_arr = np.empty(n, dtype=np.float64)
+    cdef double[::1] out = out_arr
+    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     if y.shape[0] != n:
         raise ValueError("x and y must have the same length")
     with nogil:
         for i in range(n):
             out[i] = size_at(&S, x[i], y[i])
     return out_arr
+
+
+def size_field_count(double constant, const double[:, ::1] xy, const double[::1] w,
+                     const double[::1] g, const int32_t[:, ::1] tv, const int32_t[:, ::1] nb,
+                     double rate, double reach, double min_rate, double unit_area):
+    """(about how many triangles of area unit_area * h^2 the field asks for on its
+    background, the background's area): see sizing.pxi's count_triangles_asked."""
+    cdef SizeField S
+    cdef double area = 0.0, count
+    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
+    with nogil:
+        count = count_triangles_asked(&S, min_rate, unit_area, &area)
+    return count, area
 
 
 def limit_gradation_mesh(const double[:, ::1] xy, const int32_t[:, ::1] tv, double[::1] h,
@@ -828,3 +849,135 @@ def segment_problems(const int64_t[:, ::1] seg, const double[:, ::1] xy):
         return 0
     return segment_flags(&seg[0, 0], seg.shape[0], xy.shape[0],
                          &xy[0, 0] if xy.shape[0] else NULL)
+
+
+def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
+                        const double[::1] g, const int32_t[:, ::1] tv,
+                        const int32_t[:, ::1] nb, double rate, double reach,
+                        const double[:, ::1] vertices, const int32_t[:, ::1] segments,
+                        int max_samples, double max_pieces):
+    """The split points of each segment by the size field of set_size_field
+    (discretize.pxi): returns (pieces (m,) int64, points (k, 2), row (k,) the segment
+    of each point), the points segment by segment, in order along each; or
+    (total, None, None) when the pieces would number more than max_pieces."""
+    cdef SizeField S
+    cdef Py_ssize_t m = segments.shape[0], i, k, n_pts = 0, at = 0
+    cdef int ns
+    cdef double total = 0.0, c, t
+    cdef const double* a
+    cdef const double* b
+    if max_samples < DISCRETIZE_MIN_SAMPLES:
+        raise ValueError(f"max_samples must be at least {DISCRETIZE_MIN_SAMPLES}")
+    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
+    cum_arr = np.empty(max_samples, dtype=np.float64)
+    pieces_arr = np.empty(m, dtype=np.int64)
+    cdef double[::1] cum = cum_arr
+    cdef int64_t[::1] pieces = pieces_arr
+    with nogil:
+        for i in range(m):
+            a = &vertices[segments[i, 0], 0]
+            b = &vertices[segments[i, 1], 0]
+            ns = _sample_count(&S, a, b, max_samples)
+            c = rint(_inverse_size_integral(&S, a, b, ns, &cum[0]))
+            pieces[i] = <int64_t> c if c >= 1.0 else 1
+            total += c if c >= 1.0 else 1.0
+            n_pts += pieces[i] - 1
+    if not total <= max_pieces:
+        return total, None, None
+    pts_arr = np.empty((n_pts, 2), dtype=np.float64)
+    row_arr = np.empty(n_pts, dtype=np.int64)
+    cdef double[:, ::1] pts = pts_arr
+    cdef int64_t[::1] row = row_arr
+    with nogil:
+        for i in range(m):
+            if pieces[i] == 1:
+                continue
+            a = &vertices[segments[i, 0], 0]
+            b = &vertices[segments[i, 1], 0]
+            ns = _sample_count(&S, a, b, max_samples)
+            _inverse_size_integral(&S, a, b, ns, &cum[0])
+            for k in range(1, pieces[i]):
+                t = _inverse_interp(cum[ns - 1] * k / pieces[i], &cum[0], ns)
+                pts[at, 0] = a[0] + t * (b[0] - a[0])
+                pts[at, 1] = a[1] + t * (b[1] - a[1])
+                row[at] = i
+                at += 1
+    return pieces_arr, pts_arr, row_arr
+
+
+def discretize_boundary(double constant, const double[:, ::1] xy, const double[::1] w,
+                        const double[::1] g, const int32_t[:, ::1] tv,
+                        const int32_t[:, ::1] nb, double rate, double reach,
+                        const double[:, ::1] vertices, const int32_t[:, ::1] segments,
+                        const int32_t[::1] source, int max_samples, double max_pieces):
+    """discretize_segments, then the new PSLG at once: (vertices, segments, source)
+    with the unsplit segments first, then each split segment as the chain through its
+    split points (new vertices appended in that order); a split point that rounds
+    onto the one before it or onto the segment's end is dropped (a piece of zero
+    length would be fatal).  (total, None, None) as discretize_segments."""
+    pieces_arr, pts_arr, row_arr = discretize_segments(
+        constant, xy, w, g, tv, nb, rate, reach, vertices, segments, max_samples, max_pieces)
+    if pts_arr is None:
+        return pieces_arr, None, None
+    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, k, at = 0, kept = 0
+    cdef Py_ssize_t n_simple = 0, n_seg, s_at, first
+    cdef int64_t[::1] pieces = pieces_arr
+    cdef double[:, ::1] pts = pts_arr
+    cdef const double* prev
+    keep_arr = np.zeros(len(pts_arr), dtype=np.uint8)
+    per_arr = np.zeros(m, dtype=np.int64)          # kept split points per segment
+    cdef uint8_t[::1] keep = keep_arr
+    cdef int64_t[::1] per = per_arr
+    for i in range(m):
+        if pieces[i] == 1:
+            n_simple += 1
+            continue
+        prev = &vertices[segments[i, 0], 0]
+        for k in range(pieces[i] - 1):
+            if not ((pts[at, 0] == prev[0] and pts[at, 1] == prev[1]) or (
+                    pts[at, 0] == vertices[segments[i, 1], 0]
+                    and pts[at, 1] == vertices[segments[i, 1], 1])):
+                keep[at] = 1
+                per[i] += 1
+                kept += 1
+            prev = &pts[at, 0]
+            at += 1
+    n_seg = n_simple + (m - n_simple) + kept
+    v_out = np.empty((nv + kept, 2), dtype=np.float64)
+    s_out = np.empty((n_seg, 2), dtype=np.int32)
+    e_out = np.empty(n_seg, dtype=np.int32)
+    cdef double[:, ::1] vo = v_out
+    cdef int32_t[:, ::1] so = s_out
+    cdef int32_t[::1] eo = e_out
+    for i in range(nv):
+        vo[i, 0] = vertices[i, 0]
+        vo[i, 1] = vertices[i, 1]
+    s_at = 0
+    for i in range(m):
+        if pieces[i] == 1:
+            so[s_at, 0] = segments[i, 0]
+            so[s_at, 1] = segments[i, 1]
+            eo[s_at] = source[i]
+            s_at += 1
+    at = 0
+    kept = 0
+    for i in range(m):
+        if pieces[i] == 1:
+            continue
+        first = segments[i, 0]
+        for k in range(pieces[i] - 1):
+            if keep[at]:
+                vo[nv + kept, 0] = pts[at, 0]
+                vo[nv + kept, 1] = pts[at, 1]
+                so[s_at, 0] = first
+                so[s_at, 1] = nv + kept
+                eo[s_at] = source[i]
+                first = nv + kept
+                s_at += 1
+                kept += 1
+            at += 1
+        so[s_at, 0] = first
+        so[s_at, 1] = segments[i, 1]
+        eo[s_at] = source[i]
+        s_at += 1
+    return v_out, s_out, e_out

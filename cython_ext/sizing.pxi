@@ -20,7 +20,7 @@
 #
 # Uses: sizing.pxd (SizeField); nothing else of the kernel.
 
-from libc.math cimport sqrt, INFINITY, isinf
+from libc.math cimport sqrt, fabs, log1p, INFINITY, isinf
 from libc.stdlib cimport malloc, free, realloc
 from libc.string cimport memcpy
 from libc.stdint cimport int32_t
@@ -171,6 +171,42 @@ cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil
     h = size_at(S, x, y)
     S.vhint[v] = S.hint
     return h
+
+
+cdef double count_triangles_asked(SizeField* S, double min_rate, double unit_area,
+                             double* area_out) noexcept nogil:
+    """About how many triangles of area unit_area h^2 the field asks for over its
+    background.  Each background triangle counts the larger of its area over its
+    centroid's size and the graded disks around its corners: around a vertex of size
+    g with h growing at rate r, the count within radius R is about
+    2 pi / r^2 ln(1 + r R / g), only logarithmic in 1 / g, so one tiny feature does
+    not make the count explode, nor vanish inside a large triangle.  The triangles'
+    total area goes to area_out."""
+    cdef int t, k
+    cdef const double* p[3]
+    cdef double cx, cy, area, hc, dense, disks, r, dx, dy, total = 0.0
+    cdef double rate = S.rate if S.rate > min_rate else min_rate
+    # each corner is a third of a disk on average (a triangle's angles sum to pi)
+    cdef double disk = 2.0 * 3.141592653589793 / 3.0 / (unit_area * rate * rate)
+    area_out[0] = 0.0
+    for t in range(S.nt):
+        for k in range(3):
+            p[k] = &S.xy[2 * S.tv[3 * t + k]]
+        area = 0.5 * fabs((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                          - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]))
+        cx = (p[0][0] + p[1][0] + p[2][0]) / 3.0
+        cy = (p[0][1] + p[1][1] + p[2][1]) / 3.0
+        hc = size_at(S, cx, cy)
+        dense = area / (unit_area * hc * hc)
+        disks = 0.0
+        for k in range(3):
+            dx = p[k][0] - cx
+            dy = p[k][1] - cy
+            r = sqrt(dx * dx + dy * dy)
+            disks += disk * log1p(rate * r / S.g[S.tv[3 * t + k]])
+        total += dense if dense > disks else disks
+        area_out[0] += area
+    return total
 
 
 # ------------------------------------------------ gradation limit on a graph

@@ -109,3 +109,55 @@ def test_reach_then_gradation():
     assert f(5.0 + BOUNDARY_REACH * 0.01, 5.0) == pytest.approx(0.01)
     assert f(6.0, 5.0) == pytest.approx(0.01 + 0.3 * (1.0 - BOUNDARY_REACH * 0.01))
     assert f(9.0, 9.0) == 1.0
+
+
+@pytest.mark.parametrize("scale", [1.0, 0.3])
+def test_compiled_discretization_follows_the_size(scale):
+    """The kernel's discretize_segments (the integral of 1/h along each segment, from
+    a few samples per piece): as many pieces as a fine numerical integral of 1/h
+    says (rounded; one more or less where it is near a half), split points in order
+    strictly inside their segment, and each piece within a third of the size at its
+    middle."""
+    from aftmesh import _kernel
+
+    ring = np.array(
+        [(0, 0), (3, 0.1), (3.05, 0.12), (6, 0), (6, 4), (3.5, 4.2), (3.45, 4.18), (0, 4)],
+        dtype=float,
+    )
+    seg = np.c_[np.arange(len(ring)), (np.arange(len(ring)) + 1) % len(ring)].astype(np.int32)
+    field = aftmesh.generate(Polygon(ring), 0.4 * scale).info["size_field"]
+    pieces, pts, row = _kernel.discretize_segments(*field.kernel_args(), ring, seg, 32, np.inf)
+    fine = np.linspace(0.0, 1.0, 4001)
+    for i, (a, b) in enumerate(ring[seg]):
+        x = a[None, :] + fine[:, None] * (b - a)[None, :]
+        integral = np.trapezoid(1.0 / field(x[:, 0], x[:, 1]), dx=np.linalg.norm(b - a) / 4000)
+        assert abs(pieces[i] - max(1.0, np.rint(integral))) <= 1
+        chain = np.vstack([a, pts[row == i], b])
+        t = (chain - a) @ (b - a) / ((b - a) @ (b - a))
+        assert np.all(np.diff(t) > 0)
+        mid = 0.5 * (chain[1:] + chain[:-1])
+        ratio = np.linalg.norm(np.diff(chain, axis=0), axis=1) / field(mid[:, 0], mid[:, 1])
+        if pieces[i] > 1:
+            assert np.all((ratio > 0.67) & (ratio < 1.5)), ratio
+
+
+def test_compiled_chains_equal_the_numpy_chains():
+    """discretize_boundary (the whole new PSLG in the kernel) gives exactly what the
+    retry path's numpy _chains makes of the same split points."""
+    from aftmesh import _kernel, boundary
+
+    ring = np.array([(0, 0), (5, 0), (5, 0.01), (5.02, 3), (0, 3)], dtype=float)
+    seg = np.c_[np.arange(5), (np.arange(5) + 1) % 5].astype(np.int32)
+    src = np.arange(5, dtype=np.int32)
+    for size in (0.3, 0.05, lambda x, y: 0.02 + 0.1 * x):
+        field = aftmesh.generate(Polygon(ring), size).info["size_field"]
+        fast = boundary.discretize(ring, seg, src, field)
+        pieces, pts, row = _kernel.discretize_segments(*field.kernel_args(), ring, seg, 32, np.inf)
+        split = np.flatnonzero(pieces > 1)
+        a, b = ring[seg[:, 0]], ring[seg[:, 1]]
+        slow = boundary._chains(
+            ring, seg, src, pieces == 1, split, row, pieces[split] - 1, pts, a, b
+        )
+        assert len(fast[1]) > len(seg)
+        for x, y in zip(fast, slow):
+            assert np.array_equal(x, y)

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._kernel import size_field_count
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
@@ -78,29 +79,14 @@ def _progress_callback(progress, expected_triangles: int):
 def expected_triangles(field: SizeField, area: float, gradation: float) -> float:
     """About how many triangles the size field asks for on `area`: the integral of
     1 / (equilateral area of h) over the background's triangles, scaled to the
-    domain's share of them.  Each triangle counts the larger of its centroid's size
-    over its area and the graded disks around its corners (around a vertex of size g
-    with h growing at rate r, the count within radius R is about
-    2 pi / r^2 * ln(1 + r R / g), only logarithmic in 1/g), so one tiny feature does not
-    make the estimate explode, nor vanish inside a large triangle."""
+    domain's share of them (the kernel's size_field_count says how it counts)."""
     with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
         if field.is_constant:
             return float(
                 np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min)) / field.h_min
             )
-        p = field.points[field.triangles]
-        e1, e2 = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]
-        tri_area = 0.5 * np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
-        c = p.mean(axis=1)
-        hc = field(c[:, 0], c[:, 1])
-        dense = tri_area / (EQUILATERAL_AREA * hc * hc)
-        rate = max(field.rate, MIN_ESTIMATE_RATE)
-        g = field.graded[field.triangles]
-        radius = np.linalg.norm(p - c[:, None, :], axis=2)
-        # each corner is a third of a disk on average (the angles sum to pi)
-        disks = (2 * np.pi / 3 / (EQUILATERAL_AREA * rate * rate)) * np.log1p(rate * radius / g)
-        total = np.maximum(dense, disks.sum(axis=1)).sum()
-        return float(total * min(1.0, area / max(tri_area.sum(), 1e-300)) * ESTIMATE_MARGIN)
+        total, covered = size_field_count(*field.kernel_args(), MIN_ESTIMATE_RATE, EQUILATERAL_AREA)
+        return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
 
 
 def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:

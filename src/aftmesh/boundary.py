@@ -11,17 +11,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._kernel import discretize_boundary, discretize_segments
+from .errors import InvalidSizeError
 from .sizing import SizeField
 
-# Points per segment at which the size is read to integrate 1/h: the size field is
-# graded, so 31 intervals follow it closely along any one input edge.
-_SAMPLES = 32
-# Below this relative difference of h between two samples, 1/h is integrated as the
-# mean of the ends (the exact log formula would divide by nearly zero).
-_FLAT = 1e-9
-# Split points interpolated at once, times the samples per segment: bounds the
-# temporary arrays of _interp_rows (a few megabytes).
-INTERP_CHUNK = 1 << 20
+# At most this many points per segment at which the size is read to integrate 1/h
+# (cython_ext/discretize.pxi takes fewer on segments short against the size there):
+# the field is graded, so 31 intervals follow it closely along any one input edge.
+MAX_SAMPLES = 32
 
 
 def discretize(
@@ -48,28 +45,29 @@ def discretize(
         return vertices, segments, source
     a = vertices[segments[:, 0]]
     b = vertices[segments[:, 1]]
-    length = np.linalg.norm(b - a, axis=1)
-    if field.is_constant:
-        cum = (length / field.constant)[:, None] * np.array([0.0, 1.0])
-        s = np.array([0.0, 1.0])  # the integral of 1/h is linear: its two ends say it all
-    else:
-        cum, s = _integral_of_inverse_size(a, b, length, field)
-    total = float(np.rint(cum[:, -1]).clip(min=1).sum())
-    if max_pieces is not None and not total <= max_pieces:
-        from .errors import InvalidSizeError
-
-        raise InvalidSizeError(
-            f"{limit} is below what the boundary alone needs: about {total:.3g} edges at "
-            "this size (each a side of a different triangle but for a few)"
+    if not clear > 0:
+        out = discretize_boundary(
+            *field.kernel_args(),
+            np.ascontiguousarray(vertices, dtype=np.float64),
+            np.ascontiguousarray(segments, dtype=np.int32),
+            np.ascontiguousarray(source, dtype=np.int32),
+            MAX_SAMPLES,
+            np.inf if max_pieces is None else float(max_pieces),
         )
-    pieces = np.maximum(1, np.rint(cum[:, -1]).astype(np.int64))
+        if out[1] is None:
+            _refuse(out[0], limit)
+        return out
+    pieces, pts, row = discretize_segments(
+        *field.kernel_args(),
+        np.ascontiguousarray(vertices, dtype=np.float64),
+        np.ascontiguousarray(segments, dtype=np.int32),
+        MAX_SAMPLES,
+        np.inf if max_pieces is None else float(max_pieces),
+    )
+    if pts is None:
+        _refuse(pieces, limit)
     split = np.flatnonzero(pieces > 1)
     counts = pieces[split] - 1  # split points of each split segment
-    row = np.repeat(split, counts)  # the segment of each split point
-    step = np.arange(len(row)) - np.repeat(np.cumsum(counts) - counts, counts) + 1
-    targets = cum[row, -1] * step / pieces[row]
-    t = _interp_rows(targets, cum, row, s)
-    pts = a[row] + t[:, None] * (b - a)[row]
     if clear > 0 and len(split):
         points = np.split(pts, np.cumsum(counts)[:-1])
         points = _clear_of_others(points, split, a, b, clear)
@@ -80,53 +78,11 @@ def discretize(
     return _chains(vertices, segments, source, pieces == 1, split, row, counts, pts, a, b)
 
 
-def _integral_of_inverse_size(a, b, length, field):
-    """The cumulative integral of 1/h along each segment at _SAMPLES points, and the
-    points' parameters along the segments."""
-    s = np.linspace(0.0, 1.0, _SAMPLES)
-    xs = a[:, None, 0] + (b - a)[:, None, 0] * s
-    ys = a[:, None, 1] + (b - a)[:, None, 1] * s
-    h = field(xs, ys)
-    # cumulative integral of 1/h along each segment, h taken linear between samples:
-    # the exact integral of 1/h on such a piece is ds * ln(h1/h0) / (h1 - h0) (the
-    # trapezoid rule overcounts enormously next to a tiny size, where h varies by
-    # orders of magnitude within one sample interval)
-    ds = length[:, None] / (_SAMPLES - 1)
-    h0 = h[:, :-1]
-    h1 = h[:, 1:]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        log_mean = np.where(
-            np.abs(h1 - h0) > _FLAT * h0, (np.log(h1) - np.log(h0)) / (h1 - h0), 2.0 / (h0 + h1)
-        )
-    steps = ds * log_mean
-    cum = np.concatenate([np.zeros((len(a), 1)), np.cumsum(steps, axis=1)], axis=1)
-    return cum, s
-
-
-def _interp_rows(x: np.ndarray, cum: np.ndarray, row: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """``np.interp(x[i], cum[row[i]], s)`` for every i at once, with the same
-    arithmetic as numpy's (so the same roundings): the interval found by the last
-    sample <= x, a sample hit exactly or the last one returned as is, otherwise
-    slope * (x - left) + s[left], from the other end if that is NaN."""
-    out = np.empty(len(x))
-    chunk = max(1, INTERP_CHUNK // cum.shape[1])
-    last = cum.shape[1] - 1
-    for lo in range(0, len(x), chunk):
-        xs, rows = x[lo : lo + chunk], row[lo : lo + chunk]
-        c = cum[rows]
-        j = np.clip((c <= xs[:, None]).sum(axis=1) - 1, 0, last)
-        j1 = np.minimum(j + 1, last)
-        left, right = c[np.arange(len(xs)), j], c[np.arange(len(xs)), j1]
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            slope = (s[j1] - s[j]) / (right - left)
-            val = slope * (xs - left) + s[j]
-            nan = np.isnan(val)
-            if nan.any():
-                other = slope * (xs - right) + s[j1]
-                val = np.where(nan, np.where(np.isnan(other) & (s[j] == s[j1]), s[j], other), val)
-        exact = (j == last) | (left == xs)
-        out[lo : lo + chunk] = np.where(exact, s[j], val)
-    return out
+def _refuse(total: float, limit: str):
+    raise InvalidSizeError(
+        f"{limit} is below what the boundary alone needs: about {total:.3g} edges at "
+        "this size (each a side of a different triangle but for a few)"
+    )
 
 
 def _chains(vertices, segments, source, simple, split, row, counts, pts, a, b):
