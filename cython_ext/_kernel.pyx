@@ -915,11 +915,11 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     split points (new vertices appended in that order); a split point that rounds
     onto the one before it or onto the segment's end is dropped (a piece of zero
     length would be fatal).  (total, None, None) as discretize_segments."""
-    pieces_arr, pts_arr, row_arr = discretize_segments(
+    pieces_arr, pts_arr, _ = discretize_segments(
         constant, xy, w, g, tv, nb, rate, reach, vertices, segments, max_samples, max_pieces)
     if pts_arr is None:
         return pieces_arr, None, None
-    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, k, at = 0, kept = 0
+    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, at = 0, kept = 0
     cdef Py_ssize_t n_simple = 0, n_seg, s_at, first
     cdef int64_t[::1] pieces = pieces_arr
     cdef double[:, ::1] pts = pts_arr
@@ -933,7 +933,7 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
             n_simple += 1
             continue
         prev = &vertices[segments[i, 0], 0]
-        for k in range(pieces[i] - 1):
+        for _ in range(pieces[i] - 1):
             if not ((pts[at, 0] == prev[0] and pts[at, 1] == prev[1]) or (
                     pts[at, 0] == vertices[segments[i, 1], 0]
                     and pts[at, 1] == vertices[segments[i, 1], 1])):
@@ -965,7 +965,7 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         if pieces[i] == 1:
             continue
         first = segments[i, 0]
-        for k in range(pieces[i] - 1):
+        for _ in range(pieces[i] - 1):
             if keep[at]:
                 vo[nv + kept, 0] = pts[at, 0]
                 vo[nv + kept, 1] = pts[at, 1]

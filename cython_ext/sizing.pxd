@@ -12,6 +12,7 @@ cdef struct SizeField:
     double rate         # a vertex's size g grows by at most this per unit of distance ...
     double reach        # ... beyond this many times g from the vertex
     int32_t hint        # the triangle the last look-up ended in: the next walk starts there
-    int32_t* vhint      # per mesh vertex: the background triangle of the last look-up
-    int32_t vhint_cap   # made from it (-1: none yet), so walks stay short when the
-                        # front jumps across the domain
+    # per mesh vertex, the background triangle of the last look-up made from it (-1:
+    # none yet), so walks stay short when the front jumps across the domain
+    int32_t* vhint
+    int32_t vhint_cap

@@ -174,7 +174,7 @@ cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil
 
 
 cdef double count_triangles_asked(SizeField* S, double min_rate, double unit_area,
-                             double* area_out) noexcept nogil:
+                                  double* area_out) noexcept nogil:
     """About how many triangles of area unit_area h^2 the field asks for over its
     background.  Each background triangle counts the larger of its area over its
     centroid's size and the graded disks around its corners: around a vertex of size
