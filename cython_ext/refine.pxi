@@ -543,6 +543,13 @@ cdef bint _split_is_valid(Tri* T, int e, const double* m) noexcept nogil:
         m[0] != P(T, b)[0] or m[1] != P(T, b)[1])
 
 
+cdef inline double _ulp(double v) noexcept nogil:
+    """The spacing of doubles at |v| (one unit in the last place)."""
+    cdef int ex
+    frexp(v, &ex)
+    return ldexp(1.0, ex - 53)
+
+
 cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
     """Accept m, or move it by up to SPLIT_NUDGE_ULPS to either side of e's edge: a
     point an ulp off a segment can invert a sliver of triangle next to it."""
@@ -553,7 +560,7 @@ cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
     cdef int k
     if _split_is_valid(T, e, m):
         return True
-    h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
+    h = _ulp(max(fabs(x0), fabs(y0))) / L
     for k in range(1, 2 * SPLIT_NUDGE_ULPS + 1):
         # 1, -1, 2, -2, ... ulps along the normal
         m[0] = x0 + ((k + 1) // 2) * (1 if k % 2 else -1) * h * nx
@@ -597,7 +604,7 @@ cdef bint _inward_point(Refine* R, Tri* T, int f, int u, int w, double* m) noexc
             _chain_point(R, T, u, w, t, m)
         x0 = m[0]
         y0 = m[1]
-        h = 2.220446049250313e-16 * max(fabs(x0), fabs(y0)) / L
+        h = _ulp(max(fabs(x0), fabs(y0))) / L
         for k in range(SPLIT_NUDGE_ULPS + 1):
             m[0] = x0 + k * h * nx      # (nx, ny) / L: the normal into f's triangle
             m[1] = y0 + k * h * ny

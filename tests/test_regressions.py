@@ -804,3 +804,43 @@ def test_boundary_edge_lengths_hold_next_to_the_boundary():
     assert tiny(50.1, 50.1) == pytest.approx(1e-6, rel=1e-9)
     assert tiny(52.1, 50.1) == pytest.approx(1e-6 + 0.3 * (2.0 - BOUNDARY_REACH * 1e-6), rel=1e-9)
     assert tiny(90.0, 90.0) == 1.0  # the user's size far away
+
+
+def test_refine_split_points_stay_within_ulps_of_their_segment(checked):
+    """A needle 7.8e-6 wide, 5e7 from the origin: the min-angle pass splits its long
+    sides, and a split that would invert a sliver next to it is moved off the
+    segment.  The move was eps * |x| (one to two ulps) on top of the point's own
+    rounding, 3 ulps in all here; it is one ulp now, and the segment points lie within
+    fuzz_domains.SEGMENT_POINT_ULPS of their edge.  Found by the fuzzer
+    (sliver-needle+offset)."""
+    x0, y0 = 51089502.98058855, -51089502.98058855
+    poly = Polygon([(x0, y0), (x0 + 1.0, y0), (x0, -51089502.98058077)])
+    case = fd.FuzzCase("sliver-needle", poly, None, {"close_factor": 0.0}, [poly])
+    assert fd.run_case(case, check=checked) is not None
+
+
+def test_greedy_mesh_of_nearly_cocircular_points_is_the_exact_cdt(checked):
+    """Points on the unit circle to within rounding (a spiky ring): Triangle's CDT of
+    them is not Delaunay at one quad (its incircle test misjudges four points that
+    nearly share a circle), so the fuzzer's oracle called aftmesh's mesh wrong.  The
+    oracle now settles such a disagreement in rational arithmetic; aftmesh's mesh
+    passes the rational empty-circle test on every edge.  Found by the fuzzer
+    (sliver-spikes/dict, greedy)."""
+    # fmt: off
+    V = [[-2.8284271247461907, -2.82842712474619], [-2.5591946833575663, 3.1341095773687676e-16],
+         [-0.9999500004166653, -0.00999983333416633], [-0.9999500004166653, 0.009999833334166574],
+         [-0.7141423761034396, -0.7000004761807905], [-0.7071067811865475, 0.7071067811865476],
+         [-0.7000004761807908, -0.7141423761034393], [-1.8369701987210297e-16, -1.0],
+         [6.123233995736766e-17, 1.0], [0.7000004761807905, -0.7141423761034396],
+         [0.7000004761807905, 0.7141423761034396], [0.7141423761034392, -0.7000004761807909],
+         [0.7141423761034396, 0.7000004761807905], [1.0, 0.0],
+         [1.4142206334409066, -1.4142206334409073], [2.6877409528765566, 2.687740952876556]]
+    S = [[13, 12], [12, 15], [15, 10], [10, 8], [8, 5], [5, 3], [3, 1], [1, 2], [2, 4], [4, 0],
+         [0, 6], [6, 7], [7, 9], [9, 14], [14, 11], [11, 13]]
+    # fmt: on
+    mesh = aftmesh.generate({"vertices": V, "segments": S}, 0.5, split_boundary=False, greedy=True)
+    checked(mesh)
+    P = np.asarray(mesh.points)
+    seg = {tuple(sorted(s)) for s in np.asarray(mesh.segments).tolist()}
+    assert fd._illegal_edges(P, [tuple(t) for t in np.asarray(mesh.triangles).tolist()], seg) == 0
+    fd.check_cdt_with_triangle(mesh, np.zeros((0, 2)))  # the oracle accepts it now
