@@ -196,6 +196,7 @@ cdef double count_triangles_asked(SizeField* S, double min_rate, double unit_are
                           - (p[1][1] - p[0][1]) * (p[2][0] - p[0][0]))
         cx = (p[0][0] + p[1][0] + p[2][0]) / 3.0
         cy = (p[0][1] + p[1][1] + p[2][1]) / 3.0
+        S.hint = t      # the centroid is in t: no walk
         hc = size_at(S, cx, cy)
         dense = area / (unit_area * hc * hc)
         disks = 0.0
