@@ -368,7 +368,7 @@ def test_constraint_line_far_from_origin_accepted(checked):
 
 def test_size_grows_away_from_a_very_short_edge(checked):
     """A constraint line 1.4e-9 long inside the square [-1, 1]^2 with size 0.5: the
-    size field puts the edge's length on the four grid nodes around it, so the whole
+    grid size field of the time put the edge's length on the four nodes around it, so the whole
     grid cell (4e-3 wide) gets h = 1.4e-9, ~1e13 triangles: meshing never ends (0.8 s
     for a fraction 9e-14 of the area).  The size should grow away from the short
     edge at the gradation rate instead (a few hundred triangles more)."""
