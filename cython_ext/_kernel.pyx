@@ -450,19 +450,13 @@ cdef class Triangulation:
                        const int32_t[:, ::1] nb, double rate, double reach):
         """The size field (sizing.pxi): a constant when tv has no rows, else sizes w
         (interpolated) and g (cones of slope rate, flat to reach g) at the background
-        vertices xy, on
-        the triangles tv with neighbours nb.  The arrays are copied; the values must be
-        positive (inf in w: no user size), as the Python layer checks."""
-        cdef int nt = tv.shape[0], nv = xy.shape[0], res
-        if nt == 0:
-            res = size_field_set(&self.A.size, constant, 0, 0, NULL, NULL, NULL, NULL, NULL,
-                                 rate, reach)
-        else:
-            if w.shape[0] != nv or g.shape[0] != nv or nb.shape[0] != nt:
-                raise ValueError("size field arrays of mismatched lengths")
-            res = size_field_set(&self.A.size, constant, nv, nt, &xy[0, 0], &w[0], &g[0],
-                                 &tv[0, 0], &nb[0, 0], rate, reach)
-        if res:
+        vertices xy, on the triangles tv with neighbours nb.  The arrays are copied;
+        the values must be positive (inf in w: no user size), as the Python layer
+        checks."""
+        cdef SizeField view
+        _borrow_field(&view, constant, xy, w, g, tv, nb, rate, reach)
+        if size_field_set(&self.A.size, constant, view.nv, view.nt, view.xy, view.w, view.g,
+                          view.tv, view.nb, rate, reach):
             raise MemoryError()
 
     def size_at(self, double x, double y):
@@ -920,17 +914,14 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     if pts_arr is None:
         return pieces_arr, None, None
     cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, at = 0, kept = 0
-    cdef Py_ssize_t n_simple = 0, n_seg, s_at, first
+    cdef Py_ssize_t n_seg, s_at, first
     cdef int64_t[::1] pieces = pieces_arr
     cdef double[:, ::1] pts = pts_arr
     cdef const double* prev
     keep_arr = np.zeros(len(pts_arr), dtype=np.uint8)
-    per_arr = np.zeros(m, dtype=np.int64)          # kept split points per segment
     cdef uint8_t[::1] keep = keep_arr
-    cdef int64_t[::1] per = per_arr
     for i in range(m):
         if pieces[i] == 1:
-            n_simple += 1
             continue
         prev = &vertices[segments[i, 0], 0]
         for _ in range(pieces[i] - 1):
@@ -938,11 +929,10 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
                     pts[at, 0] == vertices[segments[i, 1], 0]
                     and pts[at, 1] == vertices[segments[i, 1], 1])):
                 keep[at] = 1
-                per[i] += 1
                 kept += 1
             prev = &pts[at, 0]
             at += 1
-    n_seg = n_simple + (m - n_simple) + kept
+    n_seg = m + kept        # each split segment: one piece more than its kept points
     v_out = np.empty((nv + kept, 2), dtype=np.float64)
     s_out = np.empty((n_seg, 2), dtype=np.int32)
     e_out = np.empty(n_seg, dtype=np.int32)

@@ -25,6 +25,7 @@ import json
 import math
 import os
 import pickle
+import re
 import select
 import signal
 import time
@@ -549,13 +550,10 @@ def _triangle_not_delaunay(P, theirs, T, unexplained, seg) -> bool:
     """Where the two disagree, is Triangle's triangulation the one that breaks the
     empty-circle property (exactly), while this mesh's triangles keep it?  Triangle's
     incircle test can misjudge points cocircular to within rounding."""
-    ours = {tuple(sorted(t)) for t in T.tolist()}
     touched = {v for i in unexplained for v in T[i]}
-    their_near = [t for t in theirs if t not in ours and touched & set(t)]
+    their_near = [t for t in theirs if touched & set(t)]
     our_near = [tuple(T[i]) for i in range(len(T)) if touched & set(T[i].tolist())]
-    return _illegal_edges(
-        P, their_near + [t for t in theirs if t in ours and touched & set(t)], seg
-    ) > 0 and (_illegal_edges(P, our_near, seg) == 0)
+    return _illegal_edges(P, their_near, seg) > 0 and _illegal_edges(P, our_near, seg) == 0
 
 
 # How far (in units in the last place of the coordinates) a mesh vertex on a segment
@@ -698,8 +696,6 @@ def _check_unsplit(mesh, case: FuzzCase, have: set) -> None:
 def _seed_on_a_segment(case: FuzzCase, message: str) -> bool:
     """The dict case's holes[i] / regions[i] named in the message lies on one of its
     segments, decided in rational arithmetic."""
-    import re
-
     m = re.match(r"(holes|regions)\[(\d+)\]", message)
     if m is None or not isinstance(case.domain, dict) or m.group(1) not in case.domain:
         return False
