@@ -222,7 +222,7 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     cdef double mx = 0.5 * (pa[0] + pb[0]), my = 0.5 * (pa[1] + pb[1])
     cdef double ex = pb[0] - pa[0], ey = pb[1] - pa[1]
     cdef double L = sqrt(ex * ex + ey * ey)
-    cdef double h = size_at_from(&A.size, mx, my, T.tv[e])
+    cdef double h = size_at_from(&A.size, mx, my, T.tv[e], T.tv[nxt(e)])
     cdef double d, height, nx, ny
     nx = -ey / L
     ny = ex / L

@@ -27,34 +27,40 @@ cdef double[4] OPT_DESCENT = [0.2, 0.08, 0.03, 0.01]
 cdef double OPT_INVALID = 1e300
 
 
-cdef double _ring_cost(Tri* T, int e0, double* worst) noexcept nogil:
-    """Sum of 1 / shape^2 over the triangles around the origin of e0 (OPT_INVALID if
-    one is flat or inverted in floating point); the worst shape goes to worst[0]."""
-    cdef int e = e0
-    cdef double q, cost = 0.0
+cdef struct Ring:
+    # The ring of the vertex v being moved, gathered once per visit so that each trial
+    # place costs one pass over flat arrays: triangle i is (v, n_i, n_(i+1)), with
+    # n_n = n_0 stored at the end.  Its edge opposite v does not move with v, so the
+    # squares of that edge's components are kept too.
+    int n
+    double x[OPT_RING_CAP + 1]
+    double y[OPT_RING_CAP + 1]
+    double ox2[OPT_RING_CAP]
+    double oy2[OPT_RING_CAP]
+
+
+cdef double _cost_at(const Ring* R, double x, double y, double* worst) noexcept nogil:
+    """Sum of 1 / shape^2 over the ring's triangles with v at (x, y) (OPT_INVALID if
+    one is flat or inverted in floating point); the worst shape goes to worst[0].
+    Each shape is _shape()'s expression term for term, so it rounds the same."""
+    cdef int i
+    cdef double ax = R.x[0] - x, ay = R.y[0] - y, bx, by, sa, s, q, cost = 0.0
+    sa = ax * ax + ay * ay
     worst[0] = 2.0
-    while True:
-        q = _shape(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]))
+    for i in range(R.n):
+        bx = R.x[i + 1] - x
+        by = R.y[i + 1] - y
+        s = sa + bx * bx + by * by + R.ox2[i] + R.oy2[i]
+        q = 3.4641016151377544 * (ax * by - ay * bx) / s
         if q < worst[0]:
             worst[0] = q
         if q <= 0.0:
             return OPT_INVALID
         cost += 1.0 / (q * q)
-        e = T.twin[prv(e)]
-        if e == e0:
-            return cost
-
-
-cdef double _cost_at(Tri* T, int v, int e0, double x, double y,
-                     double* worst) noexcept nogil:
-    """_ring_cost with v standing at (x, y) (v is put back afterwards)."""
-    cdef double ox = T.xy[2 * v], oy = T.xy[2 * v + 1], c
-    T.xy[2 * v] = x
-    T.xy[2 * v + 1] = y
-    c = _ring_cost(T, e0, worst)
-    T.xy[2 * v] = ox
-    T.xy[2 * v + 1] = oy
-    return c
+        ax = bx
+        ay = by
+        sa = bx * bx + by * by
+    return cost
 
 
 cdef inline void _circumcentre(const double* a, const double* b, const double* c,
@@ -86,12 +92,12 @@ cdef bint _needs_work(Tri* T, int e0) noexcept nogil:
             return False
 
 
-cdef int _ring_points(Tri* T, int v, int e0, double* cand, double* worst_q,
+cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* worst_q,
                       double* mean_len) noexcept nogil:
-    """Walk around v once: cand[0:2] Laplacian point, cand[2:4] mean ideal apex,
-    cand[4:6] ODT point, cand[6:8] the ideal apex of the worst triangle.  Returns the
-    number of triangles, or 0 when v must stay (next to a triangle that is not meshed,
-    or too many triangles)."""
+    """Walk around v once: gather its ring into R, and cand[0:2] Laplacian point,
+    cand[2:4] mean ideal apex, cand[4:6] ODT point, cand[6:8] the ideal apex of the
+    worst triangle.  Returns the number of triangles, or 0 when v must stay (next to a
+    triangle that is not meshed, or too many triangles)."""
     cdef int e = e0, n = 0, u, w
     cdef double ax, ay, q, area, wsum = 0.0, lsum = 0.0
     cdef double cc[2]
@@ -109,6 +115,10 @@ cdef int _ring_points(Tri* T, int v, int e0, double* cand, double* worst_q,
             return 0
         pu = P(T, u)
         pw = P(T, w)
+        R.x[n] = pu[0]
+        R.y[n] = pu[1]
+        R.ox2[n] = (pw[0] - pu[0]) * (pw[0] - pu[0])
+        R.oy2[n] = (pw[1] - pu[1]) * (pw[1] - pu[1])
         ax = 0.5 * (pu[0] + pw[0]) - 0.8660254037844386 * (pw[1] - pu[1])
         ay = 0.5 * (pu[1] + pw[1]) + 0.8660254037844386 * (pw[0] - pu[0])
         cand[0] += pu[0]
@@ -131,6 +141,9 @@ cdef int _ring_points(Tri* T, int v, int e0, double* cand, double* worst_q,
         e = T.twin[prv(e)]
         if e == e0:
             break
+    R.n = n
+    R.x[n] = R.x[0]
+    R.y[n] = R.y[0]
     cand[0] /= n
     cand[1] /= n
     cand[2] /= n
@@ -152,23 +165,21 @@ cdef inline bint _better(double cost, double worst, double best_cost,
     return cost < best_cost * (1.0 - 1e-9) and worst >= worst0
 
 
-cdef void _descend(Tri* T, int v, int e0, double L, double worst0, double* bx,
-                   double* by, double* best) noexcept nogil:
+cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* by,
+                   double* best) noexcept nogil:
     """Steps from (bx, by) against the cost's numerical gradient, the longest that
     improves first; updates (bx, by) and best."""
     cdef double d = OPT_GRAD_STEP * L, gx, gy, g, wq, c, x, y
     cdef int k
-    gx = (_cost_at(T, v, e0, bx[0] + d, by[0], &wq)
-          - _cost_at(T, v, e0, bx[0] - d, by[0], &wq))
-    gy = (_cost_at(T, v, e0, bx[0], by[0] + d, &wq)
-          - _cost_at(T, v, e0, bx[0], by[0] - d, &wq))
+    gx = _cost_at(R, bx[0] + d, by[0], &wq) - _cost_at(R, bx[0] - d, by[0], &wq)
+    gy = _cost_at(R, bx[0], by[0] + d, &wq) - _cost_at(R, bx[0], by[0] - d, &wq)
     g = sqrt(gx * gx + gy * gy)
     if not (g > 0.0) or g > OPT_INVALID * 1e-10:
         return                      # flat, or a trial place was invalid
     for k in range(4):
         x = bx[0] - OPT_DESCENT[k] * L * gx / g
         y = by[0] - OPT_DESCENT[k] * L * gy / g
-        c = _cost_at(T, v, e0, x, y, &wq)
+        c = _cost_at(R, x, y, &wq)
         if _better(c, wq, best[0], worst0):
             bx[0] = x
             by[0] = y
@@ -182,14 +193,15 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
     triangle stays counter-clockwise by the exact orient2d; then restore the CDT
     around it.  Returns 1 if v moved, 0 if not, or an error."""
     cdef int e0 = T.vhe[v], e, k
+    cdef Ring R
     cdef double cand[8]
     cdef double worst0, wq, L, c, best, x, y, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
     if e0 < 0 or not _needs_work(T, e0):
         return 0
-    if _ring_points(T, v, e0, cand, &worst0, &L) == 0:
+    if _ring_points(T, v, e0, &R, cand, &worst0, &L) == 0:
         return 0
-    best = _ring_cost(T, e0, &wq)
+    best = _cost_at(&R, cx, cy, &wq)
     if best >= OPT_INVALID:
         return 0
     bx = cx
@@ -202,12 +214,12 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
             c = 0.25 if k == 3 else 0.5
             x = cx + c * (cand[6] - cx)
             y = cy + c * (cand[7] - cy)
-        c = _cost_at(T, v, e0, x, y, &wq)
+        c = _cost_at(&R, x, y, &wq)
         if _better(c, wq, best, worst0):
             best = c
             bx = x
             by = y
-    _descend(T, v, e0, L, worst0, &bx, &by, &best)
+    _descend(&R, L, worst0, &bx, &by, &best)
     if bx == cx and by == cy:
         return 0
     T.xy[2 * v] = bx

@@ -147,18 +147,19 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     return h
 
 
-cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil:
+cdef double size_at_from(SizeField* S, double x, double y, int v, int w) noexcept nogil:
     """size_at, with the walk started where the last look-up made from mesh vertex v
-    ended (a look-up near v: Compute_new_candidate's, at the middle of an edge of v).
-    The front jumps across the domain between steps, and the walk from the last
-    look-up anywhere would then cross the background."""
+    ended (a look-up near v: Compute_new_candidate's, at the middle of the edge vw),
+    or from w when v has none yet (a vertex the front has just made).  The front
+    jumps across the domain between steps, and the walk from the last look-up
+    anywhere would then cross the background."""
     cdef int32_t* grown
     cdef int cap, i
     cdef double h
     if S.nt == 0 or v < 0:
         return size_at(S, x, y)
-    if v >= S.vhint_cap:
-        cap = 2 * v + 64
+    if v >= S.vhint_cap or w >= S.vhint_cap:
+        cap = 2 * (v if v > w else w) + 64
         grown = <int32_t*> realloc(S.vhint, cap * sizeof(int32_t))
         if grown == NULL:
             return size_at(S, x, y)     # no cache: only the walks are longer
@@ -168,6 +169,8 @@ cdef double size_at_from(SizeField* S, double x, double y, int v) noexcept nogil
         S.vhint_cap = cap
     if S.vhint[v] >= 0:
         S.hint = S.vhint[v]
+    elif w >= 0 and S.vhint[w] >= 0:
+        S.hint = S.vhint[w]
     h = size_at(S, x, y)
     S.vhint[v] = S.hint
     return h
