@@ -55,8 +55,10 @@ RESOLVE_TOLERANCE = 0.2
 RESOLVE_SPAN = 1.0
 # ... and an edge longer than this many times the size at its midpoint is split
 # anyway: a callable is seen at least that closely everywhere (a feature of it
-# narrower than that, far from the boundary, may go unseen).
-RESOLVE_COARSEST = 8
+# narrower than that, far from the boundary, may go unseen).  Smooth grading is
+# followed by the tolerance test alone; a tighter bound mostly splits long edges
+# next to a small size (across an airfoil's hole), 3 to 4 times the evaluations.
+RESOLVE_COARSEST = 32
 # Sampling rounds (each one batched call of the callable) and evaluations in all: the
 # bound on what a callable costs, whatever it does (a callable varying at every scale
 # gets this much resolution and no more).
