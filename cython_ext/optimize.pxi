@@ -19,8 +19,6 @@ cdef enum:
 # a vertex whose triangles all have a shape above this is left alone (most are, which
 # saves most of the work); shape 0.985 is a radius ratio of about 0.97
 cdef double OPT_SKIP = 0.985
-# numerical gradient: step, as a fraction of the mean edge length around the vertex
-cdef double OPT_GRAD_STEP = 1e-4
 # descent steps tried along the negative gradient, as fractions of the mean edge length
 cdef double[4] OPT_DESCENT = [0.2, 0.08, 0.03, 0.01]
 # a cost this large means a triangle turned over (or went flat) at the trial place
@@ -61,6 +59,33 @@ cdef double _cost_at(const Ring* R, double x, double y, double* worst) noexcept 
         ay = by
         sa = bx * bx + by * by
     return cost
+
+
+cdef void _cost_gradient(const Ring* R, double x, double y, double* gx,
+                         double* gy) noexcept nogil:
+    """The gradient of _cost_at in (x, y), in closed form: with a = n_i - v,
+    b = n_(i+1) - v, twice the area A = a x b and S the sum of squared edge lengths,
+    a triangle costs S^2 / (k A)^2, whose derivative is 2 S (A dS - S dA) / (k^2 A^3)
+    with dA = (a_y - b_y, b_x - a_x) and dS = -2 (a + b).  Left at 0 when a triangle
+    is flat or inverted (its cost is then OPT_INVALID, and no step is taken)."""
+    cdef int i
+    cdef double ax = R.x[0] - x, ay = R.y[0] - y, bx, by, A, S, f
+    gx[0] = 0.0
+    gy[0] = 0.0
+    for i in range(R.n):
+        bx = R.x[i + 1] - x
+        by = R.y[i + 1] - y
+        A = ax * by - ay * bx
+        if not A > 0.0:
+            gx[0] = 0.0
+            gy[0] = 0.0
+            return
+        S = ax * ax + ay * ay + bx * bx + by * by + R.ox2[i] + R.oy2[i]
+        f = 2.0 * S / (12.0 * A * A * A)          # k^2 = 12
+        gx[0] += f * (-2.0 * A * (ax + bx) - S * (ay - by))
+        gy[0] += f * (-2.0 * A * (ay + by) - S * (bx - ax))
+        ax = bx
+        ay = by
 
 
 cdef inline void _circumcentre(const double* a, const double* b, const double* c,
@@ -167,15 +192,14 @@ cdef inline bint _better(double cost, double worst, double best_cost,
 
 cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* by,
                    double* best) noexcept nogil:
-    """Steps from (bx, by) against the cost's numerical gradient, the longest that
-    improves first; updates (bx, by) and best."""
-    cdef double d = OPT_GRAD_STEP * L, gx, gy, g, wq, c, x, y
+    """Steps from (bx, by) against the cost's gradient, the longest that improves
+    first; updates (bx, by) and best."""
+    cdef double gx, gy, g, wq, c, x, y
     cdef int k
-    gx = _cost_at(R, bx[0] + d, by[0], &wq) - _cost_at(R, bx[0] - d, by[0], &wq)
-    gy = _cost_at(R, bx[0], by[0] + d, &wq) - _cost_at(R, bx[0], by[0] - d, &wq)
+    _cost_gradient(R, bx[0], by[0], &gx, &gy)
     g = sqrt(gx * gx + gy * gy)
-    if not (g > 0.0) or g > OPT_INVALID * 1e-10:
-        return                      # flat, or a trial place was invalid
+    if not (g > 0.0 and g < INFINITY):
+        return                      # flat, or at an invalid place
     for k in range(4):
         x = bx[0] - OPT_DESCENT[k] * L * gx / g
         y = by[0] - OPT_DESCENT[k] * L * gy / g
