@@ -476,7 +476,7 @@ cdef class Triangulation:
         _raise_for(&self.T, convert_to_frontal_edge_set(&self.A, &self.T))
 
     def get_next_edge(self):
-        """The built-in Get_next_edge (heap order); -1 when the front is empty."""
+        """The built-in Get_next_edge (queue order); -1 when the front is empty."""
         return get_next_edge(&self.A, &self.T)
 
     def front_edges(self):
@@ -491,10 +491,10 @@ cdef class Triangulation:
         return np.array(out, dtype=np.int32)
 
     def push_front_edge(self, int e):
-        """Queue a front edge in the heap (for Python Get_next_edge strategies that
+        """Queue a front edge (for Python Get_next_edge strategies that
         manage their own order this is not needed)."""
         self._check_edge(e)
-        _raise_for(&self.T, heap_push(&self.A, &self.T, e))
+        _raise_for(&self.T, queue_push(&self.A, &self.T, e))
 
     def edge(self, int e):
         """(origin, destination) vertex indices of half-edge e."""

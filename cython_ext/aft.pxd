@@ -1,21 +1,25 @@
 # The state of the compiled Basic_aft loop (routines in front.pxi, smoothing.pxi):
-# the heap of Get_next_edge, the options, the counters and Check_visible's output.
+# the queue of Get_next_edge, the options, the counters and Check_visible's output.
 from libc.stdint cimport int32_t, int64_t
 from cpython.ref cimport PyObject
 
 from sizing cimport SizeField
 
-cdef struct HeapItem:
-    double key
-    int64_t seq         # insertion count: ties and oldest-first
+cdef struct QueueItem:
     int32_t he          # the half-edge when pushed (it may move; org/dst identify it)
     int32_t org
     int32_t dst
+    int32_t next        # the next item of its length class, oldest first (-1: last)
 
 cdef struct Aft:
-    HeapItem* heap
-    int heap_n, heap_cap
-    int64_t seq
+    # Get_next_edge's queue: one first-in first-out list per length class, the items
+    # in a pool with a free list (front.pxi)
+    QueueItem* items
+    int32_t* head       # per class: the oldest item, or -1
+    int32_t* tail       # per class: the newest item, or -1
+    int queue_n          # items queued
+    int items_n, items_cap, free_item
+    int low_class       # no class below this one holds an item
     int order
     SizeField size
     int64_t max_triangles   # N_max of formula (4); < 0: none

@@ -35,7 +35,7 @@ class Strategy:
 
     def get_next_edge(self, kernel: Triangulation) -> int:
         """Any front edge (minimal requirement); -1 when the front is empty.
-        Built in: the kernel's heap (shortest, longest or oldest first)."""
+        Built in: the kernel's queue (shortest, longest or oldest first)."""
         return kernel.get_next_edge()
 
     def compute_new_candidate(self, kernel: Triangulation, E: int) -> tuple[float, float, float]:
