@@ -2,16 +2,18 @@
 #
 # A vertex that Basic_aft created moves to the place that most lowers the cost of its
 # triangles, the sum of 1 / shape^2 (shape: _shape(), 1 when equilateral), among a few
-# candidates: the mean of its neighbours, the mean of its triangles' ideal apexes, the
-# optimal-Delaunay (ODT) point (the area-weighted mean of its triangles'
-# circumcentres), steps towards the ideal apex of its worst triangle, and then a short
-# descent along the cost's gradient.  The cost is dominated by the worst triangle but,
-# unlike the worst shape alone, it also rewards improving the others, so a vertex next
-# to a triangle no move can mend (a short input edge) still settles the rest.  A move
-# is kept only when it lowers the cost, does not lower the worst shape around the
-# vertex and leaves every triangle counter-clockwise (exact orient2d), and then Lawson
-# flips restore the CDT around it at once: only the edges of its triangles can have
-# become illegal, and each next vertex is judged on the swapped mesh.
+# candidates: the mean of its neighbours, the optimal-Delaunay (ODT) point (the
+# area-weighted mean of its triangles' circumcentres), steps towards the ideal apex of
+# its worst triangle, and then a short descent along the cost's gradient.  (The mean
+# of all its triangles' ideal apexes is not a candidate: around a closed ring the
+# apexes' offsets from the edges' midpoints cancel, and it is the neighbours' mean.)
+# The cost is dominated by the worst triangle but, unlike the worst shape alone, it
+# also rewards improving the others, so a vertex next to a triangle no move can mend
+# (a short input edge) still settles the rest.  A move is kept only when it lowers the
+# cost, does not lower the worst shape around the vertex and leaves every triangle
+# counter-clockwise (exact orient2d), and then Lawson flips restore the CDT around it
+# at once: only the edges of its triangles can have become illegal, and each next
+# vertex is judged on the swapped mesh.
 
 cdef enum:
     OPT_RING_CAP = 64           # a vertex of more triangles than this is left alone
@@ -120,16 +122,16 @@ cdef bint _needs_work(Tri* T, int e0) noexcept nogil:
 cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* worst_q,
                       double* mean_len) noexcept nogil:
     """Walk around v once: gather its ring into R, and cand[0:2] Laplacian point,
-    cand[2:4] mean ideal apex, cand[4:6] ODT point, cand[6:8] the ideal apex of the
-    worst triangle.  Returns the number of triangles, or 0 when v must stay (next to a
-    triangle that is not meshed, or too many triangles)."""
+    cand[2:4] ODT point, cand[4:6] the ideal apex of the worst triangle.  Returns the
+    number of triangles, or 0 when v must stay (next to a triangle that is not meshed,
+    or too many triangles)."""
     cdef int e = e0, n = 0, u, w
-    cdef double ax, ay, q, area, wsum = 0.0, lsum = 0.0
+    cdef double q, area, wsum = 0.0, lsum = 0.0
     cdef double cc[2]
     cdef double* pu
     cdef double* pw
     cdef double* pv = P(T, v)
-    for n in range(8):
+    for n in range(6):
         cand[n] = 0.0
     n = 0
     worst_q[0] = 2.0
@@ -144,24 +146,20 @@ cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* wors
         R.y[n] = pu[1]
         R.ox2[n] = (pw[0] - pu[0]) * (pw[0] - pu[0])
         R.oy2[n] = (pw[1] - pu[1]) * (pw[1] - pu[1])
-        ax = 0.5 * (pu[0] + pw[0]) - 0.8660254037844386 * (pw[1] - pu[1])
-        ay = 0.5 * (pu[1] + pw[1]) + 0.8660254037844386 * (pw[0] - pu[0])
         cand[0] += pu[0]
         cand[1] += pu[1]
-        cand[2] += ax
-        cand[3] += ay
         area = (pu[0] - pv[0]) * (pw[1] - pv[1]) - (pu[1] - pv[1]) * (pw[0] - pv[0])
         if area > 0.0:
             _circumcentre(pv, pu, pw, cc)
-            cand[4] += area * cc[0]
-            cand[5] += area * cc[1]
+            cand[2] += area * cc[0]
+            cand[3] += area * cc[1]
             wsum += area
         lsum += sqrt((pu[0] - pv[0]) ** 2 + (pu[1] - pv[1]) ** 2)
         q = _shape(pv, pu, pw)
         if q < worst_q[0]:
             worst_q[0] = q
-            cand[6] = ax
-            cand[7] = ay
+            cand[4] = 0.5 * (pu[0] + pw[0]) - 0.8660254037844386 * (pw[1] - pu[1])
+            cand[5] = 0.5 * (pu[1] + pw[1]) + 0.8660254037844386 * (pw[0] - pu[0])
         n += 1
         e = T.twin[prv(e)]
         if e == e0:
@@ -171,14 +169,12 @@ cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* wors
     R.y[n] = R.y[0]
     cand[0] /= n
     cand[1] /= n
-    cand[2] /= n
-    cand[3] /= n
     if wsum > 0.0:
-        cand[4] /= wsum
-        cand[5] /= wsum
+        cand[2] /= wsum
+        cand[3] /= wsum
     else:
-        cand[4] = cand[0]
-        cand[5] = cand[1]
+        cand[2] = cand[0]
+        cand[3] = cand[1]
     mean_len[0] = lsum / n
     return n
 
@@ -218,7 +214,7 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
     around it.  Returns 1 if v moved, 0 if not, or an error."""
     cdef int e0 = T.vhe[v], e, k
     cdef Ring R
-    cdef double cand[8]
+    cdef double cand[6]
     cdef double worst0, wq, L, c, best, x, y, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
     if e0 < 0 or not _needs_work(T, e0):
@@ -230,14 +226,14 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
         return 0
     bx = cx
     by = cy
-    for k in range(5):
-        if k < 3:
+    for k in range(4):
+        if k < 2:
             x = cand[2 * k]
             y = cand[2 * k + 1]
         else:
-            c = 0.25 if k == 3 else 0.5
-            x = cx + c * (cand[6] - cx)
-            y = cy + c * (cand[7] - cy)
+            c = 0.25 if k == 2 else 0.5
+            x = cx + c * (cand[4] - cx)
+            y = cy + c * (cand[5] - cy)
         c = _cost_at(&R, x, y, &wq)
         if _better(c, wq, best, worst0):
             best = c
