@@ -87,6 +87,9 @@ cdef struct Tri:
     # where the last ERR_CROSSING came from: new edge (err_a, err_b) hit edge (err_u, err_v)
     int32_t err_a, err_b, err_u, err_v
     int32_t err_seg     # ... which is a piece of input segment err_seg (-1: none)
+    # while smoothing runs, per vertex: 1 when its ring may have changed since it was
+    # last judged (legalize_meshed's flips set it for their four corners); else NULL
+    uint8_t* vdirty
 
 
 cdef inline int nxt(int e) noexcept nogil:

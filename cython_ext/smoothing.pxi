@@ -7,10 +7,12 @@
 #
 # _shape is the quality measure optimize.pxi's moves are judged by.
 #
-# Uses: halfedge.pxd; aft.pxd (Aft); front.pxi (check_signals); optimize.pxi
-# (_optimize_vertex).
+# Uses: halfedge.pxd (Tri.vdirty, which triangulation.pxi's legalize_meshed sets);
+# aft.pxd (Aft); front.pxi (check_signals); optimize.pxi (_optimize_vertex).
 from halfedge cimport *
 from aft cimport Aft
+from libc.stdlib cimport malloc, free
+from libc.string cimport memset
 
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
@@ -28,14 +30,37 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
     """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), each
     followed by Delaunay flips around the vertex, stopping early when a round moves
     nothing; signals are checked after each round.  Returns the number of vertex
-    moves, or an error."""
+    moves, or an error.
+
+    After the first round a vertex is judged again only if it moved or its ring
+    changed since it was last judged (a neighbour moved, or a flip touched it): the
+    judgement depends on nothing else, so the others would stay where they are."""
+    cdef int res
+    cdef uint8_t* dirty = <uint8_t*> malloc(T.nv if T.nv > 0 else 1)
+    if dirty == NULL:
+        return ERR_NOMEM
+    memset(dirty, 1, T.nv)
+    T.vdirty = dirty
+    res = _smooth_rounds(A, T, first_movable, passes, dirty)
+    T.vdirty = NULL
+    free(dirty)
+    return res
+
+
+cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes,
+                        uint8_t* dirty) noexcept nogil:
     cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
         for v in range(first_movable, T.nv):
+            if not dirty[v]:
+                continue
+            dirty[v] = 0
             res = _optimize_vertex(T, v)
             if res < 0:
                 return res
+            if res:
+                _mark_ring(T, v, dirty)
             moved_now += res
         moved += moved_now
         if check_signals(A) != 0:
@@ -43,3 +68,18 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
         if moved_now == 0:
             break
     return moved
+
+
+cdef void _mark_ring(Tri* T, int v, uint8_t* dirty) noexcept nogil:
+    """v moved: it and its neighbours are to be judged again."""
+    cdef int e0 = T.vhe[v], e = e0, u
+    dirty[v] = 1
+    if e0 < 0:
+        return
+    while True:
+        u = T.tv[nxt(e)]
+        if u >= 0:
+            dirty[u] = 1
+        e = T.twin[prv(e)]
+        if e == e0 or e < 0:
+            return

@@ -278,6 +278,11 @@ cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
             continue
         if incircle(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]),
                     P(T, T.tv[prv(f)])) > 0:
+            if T.vdirty != NULL:
+                T.vdirty[T.tv[e]] = 1
+                T.vdirty[T.tv[nxt(e)]] = 1
+                T.vdirty[T.tv[prv(e)]] = 1
+                T.vdirty[T.tv[prv(f)]] = 1
             flip(T, e)
             if reserve_stack(T, nstack + 4):
                 return ERR_NOMEM
