@@ -452,6 +452,46 @@ def test_max_triangles_python_loop():
         assert same_mesh(mesh, aftmesh.generate(case.domain, case.size, max_triangles=n_max))
 
 
+class _Drained(Exception):
+    pass
+
+
+class DrainQueue(Strategy):
+    """Pops the whole initial queue at the first call, recording (length, half-edge)."""
+
+    def get_next_edge(self, kernel):
+        self.popped = []
+        while (e := kernel.get_next_edge()) >= 0:
+            a, b = (np.asarray(kernel.vertex(v)) for v in kernel.edge(e))
+            self.popped.append((float(np.sum((b - a) ** 2)), e))
+        raise _Drained
+
+
+@pytest.mark.parametrize("order", ["shortest", "longest", "oldest"])
+def test_get_next_edge_order_is_length_class_then_age(order):
+    """The queue gives the front edges by length class (eighths of an octave of the
+    length: floor(4 log2 |E|^2)), shortest or longest first, the oldest first within a
+    class (the initial front is queued in half-edge order); "oldest" is plain age."""
+    rng = np.random.default_rng(5)
+    angles = np.sort(rng.uniform(0, 2 * np.pi, 40))
+    radii = rng.uniform(0.3, 1.0, 40)
+    star = Polygon(np.column_stack([radii * np.cos(angles), radii * np.sin(angles)]))
+    drain = DrainQueue()
+    with pytest.raises(_Drained):
+        aftmesh.generate(star, 10.0, order=order, strategy=drain)
+    lengths, edges = map(np.array, zip(*drain.popped))
+    assert len(edges) == len(set(edges)) >= 40
+    classes = np.floor(4 * np.log2(lengths))
+    if order == "oldest":
+        assert np.all(np.diff(edges) > 0)
+        return
+    if order == "longest":
+        classes = -classes
+    assert np.all(np.diff(classes) >= 0)
+    for c in np.unique(classes):
+        assert np.all(np.diff(edges[classes == c]) > 0)
+
+
 # ------------------------------------------------------ compiled loop vs Python loop
 class SameGetNextEdge(Strategy):
     def get_next_edge(self, kernel):
