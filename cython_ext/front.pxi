@@ -236,7 +236,8 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     distance d from a and b that the local size asks for (an equilateral triangle when
     |E| equals the size), kept between R_SIDE_MIN |E| and R_SIDE_MAX |E| (see
     _side_length) so that the triangle's shape stays good where the size changes
-    faster than the front.
+    faster than the front; where the size grows away from E (it is larger at the
+    first guess of R than at E's midpoint), by at most R_SIDE_MAX_GROWING |E|.
 
     h_out is the length New_is_preferred's proximity rules measure against: the local
     size, but at most PROXIMITY_PER_SIDE * d (see there)."""
@@ -246,14 +247,15 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     cdef double ex = pb[0] - pa[0], ey = pb[1] - pa[1]
     cdef double L = sqrt(ex * ex + ey * ey)
     cdef double h = size_at_from(&A.size, mx, my, T.tv[e], T.tv[nxt(e)])
-    cdef double d, height, nx, ny
+    cdef double d, height, nx, ny, h_r
     nx = -ey / L
     ny = ex / L
     # one correction with the size at the first guess, for graded sizes
-    d = _side_length(h, L)
+    d = _side_length(h, L, R_SIDE_MAX)
     height = sqrt(d * d - 0.25 * L * L)
-    h = 0.5 * (h + size_at(&A.size, mx + nx * height, my + ny * height))
-    d = _side_length(h, L)
+    h_r = size_at(&A.size, mx + nx * height, my + ny * height)
+    d = _side_length(0.5 * (h + h_r), L, R_SIDE_MAX_GROWING if h_r > h else R_SIDE_MAX)
+    h = 0.5 * (h + h_r)
     height = sqrt(d * d - 0.25 * L * L)
     R[0] = mx + nx * height
     R[1] = my + ny * height
@@ -269,6 +271,14 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
 # needed to grow crowd each other where fronts meet (slivers at a sharp trailing edge).
 cdef double R_SIDE_MIN = 0.75
 cdef double R_SIDE_MAX = 1.35
+# Where the size field itself grows away from E (a front leaving short input edges or
+# a fine region), a layer grows by at most this: each growing layer is a row of
+# isosceles triangles whose radius ratio falls with the growth (0.97 at 1.2, 0.93 at
+# 1.35), and these rows were most of what kept the real-world group's mean radius
+# ratio below Gmsh's (rings around small holes, transitions off short edges).  A
+# few % more triangles there; 1.2 made one case worse, and a uniform size never
+# reads it (the size at R equals the size at E), so the squares keep their lattice.
+cdef double R_SIDE_MAX_GROWING = 1.22
 cdef double R_SIDE_FAR = 3.0
 cdef double R_SIDE_FAR_LENGTH = 2.0
 # The proximity rules (close_factor * h) measure against at most this multiple of R's
@@ -281,13 +291,13 @@ cdef double R_SIDE_FAR_LENGTH = 2.0
 cdef double PROXIMITY_PER_SIDE = 1.5
 
 
-cdef inline double _side_length(double h, double L) noexcept nogil:
+cdef inline double _side_length(double h, double L, double side_max) noexcept nogil:
     if h < R_SIDE_MIN * L:
         return R_SIDE_MIN * L
     if h > R_SIDE_FAR * L:
         return R_SIDE_FAR_LENGTH * L
-    if h > R_SIDE_MAX * L:
-        return R_SIDE_MAX * L
+    if h > side_max * L:
+        return side_max * L
     return h
 
 

@@ -64,7 +64,7 @@ def test_size_callable_at_a_reentrant_corner_is_honoured(checked):
     """H r^(1/3) at an L-shape's re-entrant corner (the size a finite-element study of
     the corner singularity asks for), with gradation=1 so that the callable is taken
     as given: the mesh follows it, is never coarser than asked near the corner (finer
-    where the callable grows faster than the front can, by about 1.35 per layer),
+    where the callable grows faster than the front does, by about 1.22 per layer),
     and halving H makes the corner mesh finer.  On the grid the corner's size was
     whatever the nearest grid node gave, so halving H could make it coarser."""
     L = Polygon([(-1, -1), (1, -1), (1, 1), (0, 1), (0, 0), (-1, 0)])
