@@ -13,7 +13,6 @@ as a :class:`MeshingFailure` while the other domains still mesh.
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import copy
 import itertools
 import os
@@ -24,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._typing import SizeArg
+from ._workers import run_threads
 from .errors import InvalidOptionError
 from .mesh import Mesh
 
@@ -46,8 +46,9 @@ _ARRAYS = (
 
 _SCHEDULERS = ("threads", "dask", "serial")
 _ERRORS = ("raise", "collect")
-# Tasks kept in flight per worker: enough that no worker waits for the driver to hand
-# it the next domain, few enough that a lazy iterable of domains is not read far ahead.
+# Domains taken per worker but not yet handed to the caller (threads), or tasks kept in
+# flight per worker (Dask): enough that no worker waits for the driver, few enough
+# that a lazy iterable of domains is not read far ahead.
 IN_FLIGHT_PER_WORKER = 4
 
 
@@ -186,25 +187,8 @@ def _serial(items, options, chunksize) -> Iterator[tuple[int, Any]]:
 
 
 def _threads(items, options, workers, chunksize) -> Iterator[tuple[int, Any]]:
-    """A thread pool with a bounded window of submitted domains."""
-    window = workers * IN_FLIGHT_PER_WORKER
-    with cf.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="aftmesh") as pool:
-        pending: dict = {}
-        items = iter(items)
-        try:
-            while True:
-                for i, d, s in items:
-                    pending[pool.submit(_mesh_one, i, d, s, options)] = i
-                    if len(pending) >= window:
-                        break
-                if not pending:
-                    return
-                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    yield pending.pop(fut), fut.result()
-        finally:
-            for fut in pending:
-                fut.cancel()
+    """Worker threads that take the domains themselves, a bounded window ahead."""
+    return run_threads(items, options, workers, workers * IN_FLIGHT_PER_WORKER, _mesh_one)
 
 
 def _batches(items, chunksize):
@@ -305,7 +289,8 @@ def _results(items, total, scheduler, workers, client, errors, progress, chunksi
             raise _with_index(result) from result.error
         if progress is not None:
             progress(done, total)
-        yield index, _refreeze(result)
+        # only a Mesh unpickled from a Dask worker has writeable arrays
+        yield index, _refreeze(result) if scheduler == "dask" else result
 
 
 def _length(domains) -> int | None:
