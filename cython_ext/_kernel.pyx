@@ -845,6 +845,81 @@ def segment_problems(const int64_t[:, ::1] seg, const double[:, ::1] xy):
                          &xy[0, 0] if xy.shape[0] else NULL)
 
 
+def unique_points(const double[:, ::1] xy):
+    """(first, inverse): the distinct points of xy in lexicographic order, first[j]
+    the index of the first copy of distinct point j, inverse[i] the distinct point of
+    xy[i] (both int64); None when a coordinate is not finite or equal points differ
+    in their bits (0.0 and -0.0).  See unique_points_into in inputs.pxi."""
+    cdef Py_ssize_t n = xy.shape[0], k
+    if xy.shape[1] != 2:
+        raise ValueError("points must have shape (n, 2)")
+    first_arr = np.empty(n, dtype=np.int64)
+    work_arr = np.empty(n, dtype=np.int64)
+    inverse_arr = np.empty(n, dtype=np.int64)
+    cdef int64_t[::1] first = first_arr, work = work_arr, inverse = inverse_arr
+    if n == 0:
+        return first_arr, inverse_arr
+    with nogil:
+        k = unique_points_into(&xy[0, 0], n, &first[0], &work[0], &inverse[0])
+    return None if k < 0 else (first_arr[:k], inverse_arr)
+
+
+def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
+    """Whether no vertex lies on the interior of a segment, no segment is repeated and
+    none has equal ends (see rings_are_proper in inputs.pxi; every pair is looked at,
+    so the caller keeps it to small inputs)."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
+    if xy.shape[1] != 2 or seg.shape[1] != 2:
+        raise ValueError("points and segments must have two columns")
+    for k in range(m):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
+            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    if m == 0:
+        return True
+    return rings_are_proper(&xy[0, 0], n, &seg[0, 0], m) == 1
+
+
+def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):
+    """The length of the shortest segment at each point (inf at a point on none)."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
+    if xy.shape[1] != 2 or seg.shape[1] != 2:
+        raise ValueError("points and segments must have two columns")
+    for k in range(m):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
+            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    out_arr = np.empty(n, dtype=np.float64)
+    cdef double[::1] out = out_arr
+    if n:
+        shortest_edges_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0])
+    return out_arr
+
+
+def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits=16):
+    """The stable argsort (int32) of rounds | hilbert_keys(xy, bits): the BRIO order
+    of _order.brio_order in one call."""
+    cdef Py_ssize_t n = xy.shape[0], i
+    if rounds.shape[0] != n:
+        raise ValueError("xy and rounds differ in length")
+    if not 1 <= bits <= 31:
+        raise ValueError(f"bits must be in 1..31, got {bits}")
+    keys_arr = np.empty(n, dtype=np.int64)
+    order_arr = np.empty(n, dtype=np.int64)
+    work_arr = np.empty(n, dtype=np.int64)
+    out_arr = np.empty(n, dtype=np.int32)
+    cdef int64_t[::1] keys = keys_arr, order = order_arr, work = work_arr
+    cdef int32_t[::1] out = out_arr
+    if n == 0:
+        return out_arr
+    with nogil:
+        hilbert_keys_into(&xy[0, 0], n, bits, &keys[0])
+        for i in range(n):
+            keys[i] |= rounds[i]
+        stable_order(&keys[0], _key_less, n, &order[0], &work[0])
+        for i in range(n):
+            out[i] = <int32_t> order[i]
+    return out_arr
+
+
 def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
                         const double[::1] g, const int32_t[:, ::1] tv,
                         const int32_t[:, ::1] nb, double rate, double reach,

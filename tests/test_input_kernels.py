@@ -116,3 +116,84 @@ def test_drop_repeats_keeps_the_first_copy_of_each_segment(pairs):
 @pytest.mark.parametrize("n", [1, 7, _order.CACHED_ROUNDS, _order.CACHED_ROUNDS + 1])
 def test_cached_brio_round_keys_are_the_drawn_ones(n):
     assert (_order._round_keys(n, _order.SEED) == _order._draw_round_keys(n, _order.SEED)).all()
+
+
+@given(st.lists(st.tuples(coordinate, coordinate), max_size=12))
+def test_unique_points_gives_the_first_copy_of_each_distinct_point(rows):
+    pts = np.array(rows, dtype=np.float64).reshape(-1, 2)
+    found = _kernel.unique_points(pts)
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    srt = pts[order]
+    start = np.ones(len(pts), dtype=bool)
+    start[1:] = (srt[1:] != srt[:-1]).any(axis=1)
+    bits = srt.view(np.int64)
+    if not (bits[1:][~start[1:]] == bits[:-1][~start[1:]]).all():
+        assert found is None  # 0.0 and -0.0: left to np.unique
+        return
+    first, inverse = found
+    assert (first == order[start]).all()
+    assert (inverse[order] == np.cumsum(start) - 1).all()
+
+
+def test_unique_points_leaves_non_finite_points_to_numpy():
+    assert _kernel.unique_points(np.array([[0.0, 1.0], [np.nan, 0.0]])) is None
+
+
+# Vertices of a square ring and of a second ring touching it, for rings_proper.
+SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
+
+
+@pytest.mark.parametrize(
+    "extra, proper",
+    [
+        ([(0.5, 0.5), (1.5, 0.5), (1.0, 1.5)], True),  # a hole inside
+        ([(1.0, 0.0), (1.5, 0.5), (0.5, 0.5)], False),  # a hole corner on an edge
+        ([(2.0, 2.0), (1.5, 1.0), (1.0, 1.5)], True),  # touching at a shared corner
+        ([(3.0, 0.0), (4.0, 0.0), (3.5, 1.0)], True),  # on the edge's line, beyond it
+    ],
+)
+def test_rings_proper_agrees_with_the_split_at_vertices(extra, proper):
+    from aftmesh.noding import split_at_vertices
+
+    pts = np.array(SQUARE + extra, dtype=np.float64)
+    first, inverse = _kernel.unique_points(pts)
+    uniq = pts[first]
+    ring = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 4]])
+    segs = inverse[ring]
+    src = np.arange(len(segs))
+    split, _ = split_at_vertices(uniq, segs, src, None, 0.0, np.ones(len(src), dtype=bool))
+    assert (len(split) == len(segs)) == proper
+    assert _kernel.rings_proper(uniq, np.ascontiguousarray(segs, dtype=np.int64)) == proper
+
+
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), max_size=8))
+def test_rings_proper_refuses_repeated_and_zero_length_segments(pairs):
+    xy = np.array([[0, 0], [4, 1], [3, 5], [-1, 3], [1, 2.5]], dtype=np.float64)
+    segs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+    got, _ = _drop_repeats(segs, np.arange(len(segs)))
+    on_interior = False  # no vertex of these five is on a segment between two others
+    want = len(got) == len(segs) and not on_interior
+    assert _kernel.rings_proper(xy, segs) == want
+
+
+@given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5)), max_size=10))
+def test_shortest_edges_is_the_numpy_minimum(pairs):
+    rng = np.random.default_rng(len(pairs))
+    xy = rng.normal(size=(6, 2))
+    seg = np.array(pairs, dtype=np.int32).reshape(-1, 2)
+    lengths = np.linalg.norm(xy[seg[:, 1]] - xy[seg[:, 0]], axis=1)
+    want = np.full(len(xy), np.inf)
+    np.minimum.at(want, seg[:, 0], lengths)
+    np.minimum.at(want, seg[:, 1], lengths)
+    assert _kernel.shortest_edges(xy, seg).tobytes() == want.tobytes()
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 9, 200, 5000])
+def test_brio_keys_order_is_the_stable_numpy_argsort(n):
+    rng = np.random.default_rng(n)
+    # a coarse grid: many points share a Hilbert cell, so the sort's ties matter
+    xy = np.ascontiguousarray(rng.integers(0, 4, size=(n, 2)).astype(np.float64))
+    rounds = _order._draw_round_keys(n, _order.SEED)
+    keys = rounds | _kernel.hilbert_keys(xy)
+    want = np.argsort(keys, kind="stable").astype(np.int32)
+    assert (_kernel.brio_keys_order(xy, rounds) == want).all()

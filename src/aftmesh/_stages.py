@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import size_field_count
+from ._kernel import shortest_edges, size_field_count
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
@@ -80,11 +80,10 @@ def expected_triangles(field: SizeField, area: float, gradation: float) -> float
     """About how many triangles the size field asks for on `area`: the integral of
     1 / (equilateral area of h) over the background's triangles, scaled to the
     domain's share of them (the kernel's size_field_count says how it counts)."""
+    if field.is_constant:
+        h = float(field.constant)  # > 0; Python floats overflow to inf as numpy's do
+        return float(area) / (EQUILATERAL_AREA * h) / h
     with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
-        if field.is_constant:
-            return float(
-                np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min)) / field.h_min
-            )
         total, covered = size_field_count(*field.kernel_args(), MIN_ESTIMATE_RATE, EQUILATERAL_AREA)
         return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
 
@@ -104,12 +103,12 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
         size = per_region_size(dom.polygons, size)
     seg = dom.segments
     if len(seg):
-        lengths = np.linalg.norm(dom.vertices[seg[:, 1]] - dom.vertices[seg[:, 0]], axis=1)
-        shortest = np.full(len(dom.vertices), np.inf)
-        np.minimum.at(shortest, seg[:, 0], lengths)
-        np.minimum.at(shortest, seg[:, 1], lengths)
+        verts = np.ascontiguousarray(dom.vertices, dtype=np.float64)
+        shortest = shortest_edges(verts, np.ascontiguousarray(seg, dtype=np.int32))
         used = np.isfinite(shortest)
-        field = make_size_field(size, (lo, hi), dom.vertices[used], shortest[used], gradation)
+        if not used.all():  # a lone point: no edge there
+            verts, shortest = verts[used], shortest[used]
+        field = make_size_field(size, (lo, hi), verts, shortest, gradation)
     else:
         field = make_size_field(size, (lo, hi), gradation=gradation)
     area = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))

@@ -17,6 +17,7 @@ a long thin domain or a tiny edge does not make it bigger.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -141,8 +142,11 @@ def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> Non
 
 
 def _resolution(bounds) -> float:
-    """The spacing of doubles at the domain's largest coordinate."""
-    return float(np.spacing(float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))))
+    """The spacing of doubles at the domain's largest coordinate (math.ulp of a
+    finite magnitude below the largest double is np.spacing of it, without numpy's
+    cost per call)."""
+    (x0, y0), (x1, y1) = bounds
+    return math.ulp(max(abs(float(x0)), abs(float(y0)), abs(float(x1)), abs(float(y1))))
 
 
 def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
@@ -328,11 +332,13 @@ def make_size_field(
         # it already holds the boundary's sizes and the gradation
         return size
     constant = _parse_size(size)
-    if constant is not None:
+    if constant is not None and not constant >= MIN_SIZE_ULPS * _resolution(bounds):
         _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
     if constant is not None and (
-        not have_boundary or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant
+        not have_boundary
+        or np.asarray(boundary_lengths, dtype=np.float64).min()
+        >= CONSTANT_IF_EDGES_ABOVE * constant
     ):
         # the boundary asks for nothing smaller: a constant needs no background
         return SizeField(constant)
