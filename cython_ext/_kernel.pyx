@@ -28,6 +28,7 @@ from halfedge.pxd on failure); the methods here turn codes into exceptions.
 """
 from halfedge cimport *
 from aft cimport Aft
+from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBuffer_Release, PyObject_GetBuffer
 from cpython.ref cimport Py_XDECREF, PyObject
 from libc.stdlib cimport malloc, free
 
@@ -124,6 +125,35 @@ cdef double* _f64(arr) except? NULL:
     return &v[0] if v.shape[0] else NULL
 
 
+# The same for arrays known to be fresh, C-contiguous and of that dtype (the
+# kernel's own outputs): the buffer is read without reshaping first.
+cdef int32_t* _i32v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef int32_t* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <int32_t*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)  # arr keeps the memory
+    return out
+
+
+cdef uint8_t* _u8v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef uint8_t* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <uint8_t*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)
+    return out
+
+
+cdef double* _f64v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef double* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <double*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)
+    return out
+
+
 # The named enums of halfedge.pxd, for src/aftmesh/_states.py (tests/test_states.py
 # checks that the IntEnums there hold these values).
 TRIANGLE_STATE_VALUES = dict(FREE=T_FREE, EXTERIOR=T_EXTERIOR, UNMESHED=T_UNMESHED,
@@ -176,15 +206,15 @@ cdef class Triangulation:
         """Insert the vertices in `order` (a spatially coherent order makes the walks
         short).  Returns an int32 array `merged`: merged[v] == v for inserted vertices,
         or the index of the earlier vertex at exactly the same place."""
-        cdef int n = self.T.nv, res = 0
+        cdef int n = self.T.nv, res = 0, i
         cdef int m = order.shape[0]
         merged_arr = np.arange(n, dtype=np.int32)
         if m == 0:
             return merged_arr
-        order_np = np.asarray(order)
-        if order_np.min() < 0 or order_np.max() >= n:
-            raise ValueError(f"order holds a vertex outside 0..{n - 1}")
-        cdef int32_t* merged = _i32(merged_arr)
+        for i in range(m):
+            if not 0 <= order[i] < n:
+                raise ValueError(f"order holds a vertex outside 0..{n - 1}")
+        cdef int32_t* merged = _i32v(merged_arr)
         with nogil:
             res = insert_points(&self.T, &order[0], m, merged)
         _raise_for(&self.T, res)
@@ -403,28 +433,38 @@ cdef class Triangulation:
         (t, 3) with neighbors[i, k] across the edge opposite vertex k (-1: none),
         segments (s, 2) (constrained edges of the domain, each once), segment_ids (s,)
         the input segment each is a piece of (see insert_segments; -1: none), regions
-        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
+        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output).
+        The scratch arrays are C buffers: numpy's cost per array would exceed the
+        work on a small mesh."""
         cdef Tri* T = &self.T
-        cdef int ntri, nvo, ns
-        keep_arr = np.zeros(T.nt, dtype=np.uint8)
-        tri_index_arr = np.full(T.nt, -1, dtype=np.int32)
-        vmap_arr = np.full(T.nv, -1, dtype=np.int32)
-        cdef uint8_t* keep = _u8(keep_arr)
-        cdef int32_t* tri_index = _i32(tri_index_arr)
-        cdef int32_t* vmap = _i32(vmap_arr)
-        ntri = mark_output(T, include_exterior, keep)
-        tris_arr = np.empty((ntri, 3), dtype=np.int32)
-        regions_arr = np.empty(ntri, dtype=np.int32)
-        nvo = number_output(T, keep, tri_index, vmap, _i32(tris_arr), _i32(regions_arr))
-        points_arr = np.empty((nvo, 2), dtype=np.float64)
-        output_points(T, vmap, _f64(points_arr))
-        ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
-        nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
-        seg_arr = np.empty((ns, 2), dtype=np.int32)
-        seg_ids = np.empty(ns, dtype=np.int32)
-        if ntri:
-            output_edges(T, keep, tri_index, vmap, _i32(nbr_arr), _i32(seg_arr),
-                         _i32(seg_ids))
+        cdef int ntri, nvo, ns, t
+        cdef uint8_t* keep = <uint8_t*> malloc(max(T.nt, 1) * sizeof(uint8_t))
+        cdef int32_t* tri_index = <int32_t*> malloc(max(T.nt, 1) * sizeof(int32_t))
+        if keep == NULL or tri_index == NULL:
+            free(keep)
+            free(tri_index)
+            raise MemoryError()
+        try:
+            vmap_arr = np.full(T.nv, -1, dtype=np.int32)
+            for t in range(T.nt):
+                tri_index[t] = -1
+            ntri = mark_output(T, include_exterior, keep)
+            tris_arr = np.empty((ntri, 3), dtype=np.int32)
+            regions_arr = np.empty(ntri, dtype=np.int32)
+            nvo = number_output(T, keep, tri_index, _i32v(vmap_arr), _i32v(tris_arr),
+                                _i32v(regions_arr))
+            points_arr = np.empty((nvo, 2), dtype=np.float64)
+            output_points(T, _i32v(vmap_arr), _f64v(points_arr))
+            ns = output_edges(T, keep, tri_index, _i32v(vmap_arr), NULL, NULL, NULL)
+            nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
+            seg_arr = np.empty((ns, 2), dtype=np.int32)
+            seg_ids = np.empty(ns, dtype=np.int32)
+            if ntri:
+                output_edges(T, keep, tri_index, _i32v(vmap_arr), _i32v(nbr_arr),
+                             _i32v(seg_arr), _i32v(seg_ids))
+        finally:
+            free(keep)
+            free(tri_index)
         return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
                     segments=seg_arr, segment_ids=seg_ids,
                     regions=regions_arr, vertex_map=vmap_arr)
@@ -920,6 +960,18 @@ def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits
     return out_arr
 
 
+cdef int _check_discretize(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
+                           int max_samples) except -1:
+    cdef Py_ssize_t i, k
+    if max_samples < DISCRETIZE_MIN_SAMPLES:
+        raise ValueError(f"max_samples must be at least {DISCRETIZE_MIN_SAMPLES}")
+    for i in range(segments.shape[0]):
+        for k in range(2):
+            if not 0 <= segments[i, k] < vertices.shape[0]:
+                raise ValueError(f"segments[{i}] refers to a vertex outside the points")
+    return 0
+
+
 def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
                         const double[::1] g, const int32_t[:, ::1] tv,
                         const int32_t[:, ::1] nb, double rate, double reach,
@@ -930,47 +982,28 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
     of each point), the points segment by segment, in order along each; or
     (total, None, None) when the pieces would number more than max_pieces."""
     cdef SizeField S
-    cdef Py_ssize_t m = segments.shape[0], i, k, n_pts = 0, at = 0
-    cdef int ns
-    cdef double total = 0.0, c, t
-    cdef const double* a
-    cdef const double* b
-    if max_samples < DISCRETIZE_MIN_SAMPLES:
-        raise ValueError(f"max_samples must be at least {DISCRETIZE_MIN_SAMPLES}")
+    cdef Py_ssize_t m = segments.shape[0], n_pts = 0
+    cdef double total = 0.0
+    _check_discretize(vertices, segments, max_samples)
     _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     cum_arr = np.empty(max_samples, dtype=np.float64)
     pieces_arr = np.empty(m, dtype=np.int64)
     cdef double[::1] cum = cum_arr
     cdef int64_t[::1] pieces = pieces_arr
-    with nogil:
-        for i in range(m):
-            a = &vertices[segments[i, 0], 0]
-            b = &vertices[segments[i, 1], 0]
-            ns = _sample_count(&S, a, b, max_samples)
-            c = rint(_inverse_size_integral(&S, a, b, ns, &cum[0]))
-            pieces[i] = <int64_t> c if c >= 1.0 else 1
-            total += c if c >= 1.0 else 1.0
-            n_pts += pieces[i] - 1
+    if m:
+        with nogil:
+            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                                      &cum[0], &pieces[0], &n_pts)
     if not total <= max_pieces:
         return total, None, None
     pts_arr = np.empty((n_pts, 2), dtype=np.float64)
     row_arr = np.empty(n_pts, dtype=np.int64)
-    cdef double[:, ::1] pts = pts_arr
-    cdef int64_t[::1] row = row_arr
-    with nogil:
-        for i in range(m):
-            if pieces[i] == 1:
-                continue
-            a = &vertices[segments[i, 0], 0]
-            b = &vertices[segments[i, 1], 0]
-            ns = _sample_count(&S, a, b, max_samples)
-            _inverse_size_integral(&S, a, b, ns, &cum[0])
-            for k in range(1, pieces[i]):
-                t = _inverse_interp(cum[ns - 1] * k / pieces[i], &cum[0], ns)
-                pts[at, 0] = a[0] + t * (b[0] - a[0])
-                pts[at, 1] = a[1] + t * (b[1] - a[1])
-                row[at] = i
-                at += 1
+    cdef double* pts = _f64v(pts_arr)
+    cdef int64_t* row = <int64_t*> _f64v(row_arr)
+    if n_pts:
+        with nogil:
+            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                              &cum[0], &pieces[0], pts, row)
     return pieces_arr, pts_arr, row_arr
 
 
@@ -984,65 +1017,43 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     split points (new vertices appended in that order); a split point that rounds
     onto the one before it or onto the segment's end is dropped (a piece of zero
     length would be fatal).  (total, None, None) as discretize_segments."""
-    pieces_arr, pts_arr, _ = discretize_segments(
-        constant, xy, w, g, tv, nb, rate, reach, vertices, segments, max_samples, max_pieces)
-    if pts_arr is None:
-        return pieces_arr, None, None
-    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, at = 0, kept = 0
-    cdef Py_ssize_t n_seg, s_at, first
-    cdef int64_t[::1] pieces = pieces_arr
-    cdef double[:, ::1] pts = pts_arr
-    cdef const double* prev
-    keep_arr = np.zeros(len(pts_arr), dtype=np.uint8)
-    cdef uint8_t[::1] keep = keep_arr
-    for i in range(m):
-        if pieces[i] == 1:
-            continue
-        prev = &vertices[segments[i, 0], 0]
-        for _ in range(pieces[i] - 1):
-            if not ((pts[at, 0] == prev[0] and pts[at, 1] == prev[1]) or (
-                    pts[at, 0] == vertices[segments[i, 1], 0]
-                    and pts[at, 1] == vertices[segments[i, 1], 1])):
-                keep[at] = 1
-                kept += 1
-            prev = &pts[at, 0]
-            at += 1
-    n_seg = m + kept        # each split segment: one piece more than its kept points
-    v_out = np.empty((nv + kept, 2), dtype=np.float64)
-    s_out = np.empty((n_seg, 2), dtype=np.int32)
-    e_out = np.empty(n_seg, dtype=np.int32)
-    cdef double[:, ::1] vo = v_out
-    cdef int32_t[:, ::1] so = s_out
-    cdef int32_t[::1] eo = e_out
-    for i in range(nv):
-        vo[i, 0] = vertices[i, 0]
-        vo[i, 1] = vertices[i, 1]
-    s_at = 0
-    for i in range(m):
-        if pieces[i] == 1:
-            so[s_at, 0] = segments[i, 0]
-            so[s_at, 1] = segments[i, 1]
-            eo[s_at] = source[i]
-            s_at += 1
-    at = 0
-    kept = 0
-    for i in range(m):
-        if pieces[i] == 1:
-            continue
-        first = segments[i, 0]
-        for _ in range(pieces[i] - 1):
-            if keep[at]:
-                vo[nv + kept, 0] = pts[at, 0]
-                vo[nv + kept, 1] = pts[at, 1]
-                so[s_at, 0] = first
-                so[s_at, 1] = nv + kept
-                eo[s_at] = source[i]
-                first = nv + kept
-                s_at += 1
-                kept += 1
-            at += 1
-        so[s_at, 0] = first
-        so[s_at, 1] = segments[i, 1]
-        eo[s_at] = source[i]
-        s_at += 1
+    cdef SizeField S
+    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], n_pts = 0, kept = 0
+    cdef double total = 0.0
+    cdef double* pts
+    cdef uint8_t* keep
+    _check_discretize(vertices, segments, max_samples)
+    if source.shape[0] != m:
+        raise ValueError("segments and source differ in length")
+    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
+    cdef double* cum = <double*> malloc(max_samples * sizeof(double))
+    cdef int64_t* pieces = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
+    try:
+        if cum == NULL or pieces == NULL:
+            raise MemoryError()
+        if m:
+            with nogil:
+                total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
+                                          max_samples, cum, pieces, &n_pts)
+        if not total <= max_pieces:
+            return total, None, None
+        pts_arr = np.empty((n_pts, 2), dtype=np.float64)
+        keep_arr = np.empty(n_pts, dtype=np.uint8)
+        pts = _f64v(pts_arr)
+        keep = _u8v(keep_arr)
+        if n_pts:
+            with nogil:
+                discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                                  cum, pieces, pts, NULL)
+                kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
+        # each split segment: one piece more than its kept points
+        v_out = np.empty((nv + kept, 2), dtype=np.float64)
+        s_out = np.empty((m + kept, 2), dtype=np.int32)
+        e_out = np.empty(m + kept, dtype=np.int32)
+        if m:
+            chain_write(&vertices[0, 0], nv, &segments[0, 0], &source[0], m, pieces, pts,
+                        keep, _f64v(v_out), _i32v(s_out), _i32v(e_out))
+    finally:
+        free(cum)
+        free(pieces)
     return v_out, s_out, e_out

@@ -211,7 +211,8 @@ def build_cdt(
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain"
                 )
-    kernel.carve(hole_pts, False)
+    if len(hole_pts):  # without holes, the carve above left nothing to do
+        kernel.carve(hole_pts, False)
     if len(reg):
         kernel.assign_regions(
             np.ascontiguousarray(reg[:, :2]), np.ascontiguousarray(reg[:, 2].astype(np.int32))
