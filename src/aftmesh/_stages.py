@@ -200,7 +200,9 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
     """Give the CDT's pieces their regions, check the domain has area and fits
     max_triangles, and hand the size field and options to the kernel."""
     kernel = boundary.built.kernel
-    if dom.polygons is not None:
+    # one polygon whose one ring is the only source: the carve left one piece, in
+    # region 0 already (every triangle starts there)
+    if dom.polygons is not None and not (len(dom.polygons) == 1 and len(dom.source_names) == 1):
         comp, probes, corners = kernel.components()
         kernel.set_regions(comp, classify_pieces(dom.polygons, probes, corners))
     _, n_unmeshed, _ = kernel.state_counts()
