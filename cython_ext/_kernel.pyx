@@ -18,6 +18,7 @@ hold the ``nogil`` kernels:
 * refine.pxi         the minimum-angle pass (Delaunay refinement)
 * inputs.pxi         ring clean-up, coordinate and segment checks of the input
 * discretize.pxi     input segments split by the integral of 1/size
+* background.pxi     a size field's background triangulation and gradation, at once
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -55,6 +56,7 @@ include "optimize.pxi"
 include "refine.pxi"
 include "inputs.pxi"
 include "discretize.pxi"
+include "background.pxi"
 
 
 class KernelError(RuntimeError):
@@ -244,26 +246,7 @@ cdef class Triangulation:
         """Every live finite triangle, whatever its state: (tv (t, 3) of kernel vertex
         indices, counter-clockwise; nb (t, 3), the triangle across the edge opposite
         vertex k, -1 at the hull)."""
-        cdef Tri* T = &self.T
-        cdef int t, k, n = 0, u
-        index_arr = np.full(T.nt, -1, dtype=np.int32)
-        cdef int32_t[::1] index = index_arr
-        for t in range(T.nt):
-            if T.tstate[t] != T_FREE and not is_ghost(T, t):
-                index[t] = n
-                n += 1
-        tv_arr = np.empty((n, 3), dtype=np.int32)
-        nb_arr = np.empty((n, 3), dtype=np.int32)
-        cdef int32_t[:, ::1] tv = tv_arr
-        cdef int32_t[:, ::1] nb = nb_arr
-        for t in range(T.nt):
-            if index[t] >= 0:
-                for k in range(3):
-                    tv[index[t], k] = T.tv[3 * t + k]
-                    # the edge opposite vertex k is half-edge 3t + k + 1
-                    u = index[T.twin[3 * t + (k + 1) % 3] // 3]
-                    nb[index[t], k] = u
-        return tv_arr, nb_arr
+        return _finite_arrays(&self.T)
 
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
                         int first_id=0):
@@ -802,35 +785,75 @@ def limit_gradation_mesh(const double[:, ::1] xy, const int32_t[:, ::1] tv, doub
     max(0, |uv| - reach h[u]) along every edge of the triangles tv: the size grows by
     at most `rate` per unit of length along any path of edges (after holding for
     reach times itself)."""
-    cdef int nv = xy.shape[0], nt = tv.shape[0], t, k, a, b, res
+    cdef int nv = xy.shape[0], nt = tv.shape[0], t, k, res
     if h.shape[0] != nv:
         raise ValueError("h must have one value per vertex")
     if nt == 0 or nv == 0:
         return
-    start_arr = np.zeros(nv + 1, dtype=np.int32)
-    adj_arr = np.empty(6 * nt, dtype=np.int32)
-    fill_arr = np.empty(nv, dtype=np.int32)
-    cdef int32_t[::1] start = start_arr
-    cdef int32_t[::1] adj = adj_arr
-    cdef int32_t[::1] fill = fill_arr
+    for t in range(nt):
+        for k in range(3):
+            if not 0 <= tv[t, k] < nv:
+                raise ValueError(f"triangle {t} refers to a vertex outside 0..{nv - 1}")
     with nogil:
-        for t in range(nt):
-            for k in range(3):
-                start[tv[t, k] + 1] += 2
-        for a in range(nv):
-            start[a + 1] += start[a]
-            fill[a] = start[a]
-        for t in range(nt):
-            for k in range(3):
-                a = tv[t, k]
-                b = tv[t, (k + 1) % 3]
-                adj[fill[a]] = b
-                fill[a] += 1
-                adj[fill[b]] = a
-                fill[b] += 1
-        res = limit_gradation_graph(nv, &start[0], &adj[0], &xy[0, 0], &h[0], rate, reach)
+        res = limit_gradation_tris(nv, nt, &xy[0, 0], &tv[0, 0], &h[0], rate, reach)
     if res:
         raise MemoryError()
+
+
+cdef object _finite_arrays(Tri* T):
+    """(tv, nb) of the live finite triangles of T (see Triangulation.finite_triangles)."""
+    cdef int n
+    cdef int32_t* index = <int32_t*> malloc(max(T.nt, 1) * sizeof(int32_t))
+    if index == NULL:
+        raise MemoryError()
+    try:
+        n = finite_index(T, index)
+        tv_arr = np.empty((n, 3), dtype=np.int32)
+        nb_arr = np.empty((n, 3), dtype=np.int32)
+        if n:
+            finite_into(T, index, _i32v(tv_arr), _i32v(nb_arr))
+    finally:
+        free(index)
+    return tv_arr, nb_arr
+
+
+def background_field(const double[:, ::1] xy, const int64_t[::1] rounds, double[::1] g,
+                     double rate):
+    """The background of a size field without a callable (background.pxi): the
+    Delaunay triangulation of the points xy inserted in BRIO order (rounds: the
+    round keys of _order.brio_order), and, in place, g (one size per point)
+    gradation-limited at `rate` over its edges and inf at the points merged into
+    an equal one.  Returns (tv, nb, finite): the finite triangles as in
+    Triangulation.finite_triangles, and whether g is finite at every used point."""
+    cdef int n = xy.shape[0], i, res = 0, ok, nt
+    cdef int32_t* tv
+    cdef Tri T
+    if xy.shape[1] != 2 or rounds.shape[0] != n or g.shape[0] != n:
+        raise ValueError("xy, rounds and g must have one row per point")
+    if n < 3:
+        raise ValueError("a background needs at least 3 points")
+    if tri_init(&T, n + 16, 2 * n + 16):
+        raise MemoryError()
+    try:
+        with nogil:
+            for i in range(n):
+                res = add_vertex(&T, xy[i, 0], xy[i, 1])
+                if res < 0:
+                    break
+            if res >= 0:
+                res = brio_insert(&T, &xy[0, 0], n, &rounds[0])
+        _raise_for(&T, res)
+        tv_arr, nb_arr = _finite_arrays(&T)
+        nt = len(tv_arr)
+        tv = _i32v(tv_arr)
+        with nogil:
+            res = limit_gradation_tris(n, nt, &xy[0, 0], tv, &g[0], rate, 0.0)
+            ok = unused_to_inf(n, nt, tv, &g[0]) if res == 0 else res
+        if res or ok < 0:
+            raise MemoryError()
+    finally:
+        tri_free(&T)
+    return tv_arr, nb_arr, ok == 1
 
 
 def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t n_rings):

@@ -197,3 +197,25 @@ def test_brio_keys_order_is_the_stable_numpy_argsort(n):
     keys = rounds | _kernel.hilbert_keys(xy)
     want = np.argsort(keys, kind="stable").astype(np.int32)
     assert (_kernel.brio_keys_order(xy, rounds) == want).all()
+
+
+@pytest.mark.parametrize("n", [3, 10, 300])
+def test_background_field_is_the_triangulation_and_gradation_it_replaces(n):
+    rng = np.random.default_rng(n)
+    xy = rng.integers(0, 12, size=(n, 2)).astype(np.float64)  # repeats: merged points
+    xy[:3] = [[-1.0, -1.0], [13.0, -1.0], [6.0, 13.0]]  # never all collinear
+    g = rng.uniform(0.1, 2.0, n)
+    g[rng.integers(0, n, n // 3)] = np.inf
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(_order.brio_order(xy))
+    want_tv, want_nb = tri.finite_triangles()
+    want_g = g.copy()
+    _kernel.limit_gradation_mesh(xy, want_tv, want_g, 0.3)
+    used = np.zeros(n, dtype=bool)
+    used[want_tv.ravel()] = True
+    want_g[~used] = np.inf
+    got_g = g.copy()
+    tv, nb, finite = _kernel.background_field(xy, _order.round_keys(n), got_g, 0.3)
+    assert (tv == want_tv).all() and (nb == want_nb).all()
+    assert got_g.tobytes() == want_g.tobytes()
+    assert finite == bool(np.isfinite(want_g[used]).all())

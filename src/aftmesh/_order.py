@@ -21,6 +21,12 @@ CACHED_ROUNDS = 4096
 _cached_rounds: np.ndarray | None = None
 
 
+def round_keys(n: int, seed: int = SEED) -> np.ndarray:
+    """The BRIO round keys of n points (the high bits of brio_order's keys), for the
+    kernel's own BRIO insertions (background_field)."""
+    return _round_keys(n, seed)
+
+
 def _round_keys(n: int, seed: int) -> np.ndarray:
     """The high bits of each point's key: its BRIO round, later rounds first.  A
     generator's first n draws do not depend on how many more are drawn after them,

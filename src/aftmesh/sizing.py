@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import _kernel
-from ._order import brio_order
+from ._order import brio_order, round_keys
 from ._typing import Point2, SizeFunction
 from .errors import InvalidSizeError
 
@@ -361,6 +361,7 @@ def make_size_field(
         _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
     else:
         u = np.full(len(pts), np.inf if constant is None else constant)
+        return _numbers_field(constant, pts, u, lengths, gradation)
     tri = _kernel.Triangulation(pts)
     tri.insert_points(brio_order(pts))
     if callable(size):
@@ -385,3 +386,14 @@ def make_size_field(
         raise InvalidSizeError("could not derive a size from the boundary")
     g[~used] = np.inf  # never read: only the triangles' vertices are
     return SizeField(constant or 0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
+
+
+def _numbers_field(constant, pts: np.ndarray, u: np.ndarray, lengths: np.ndarray, gradation):
+    """make_size_field without a callable: the background, the boundary's sizes and
+    their gradation in one kernel call (the same steps as the callable's path)."""
+    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
+    g = np.minimum(u, lengths) if gradation > 1.0 else lengths.copy()
+    tv, nb, finite = _kernel.background_field(pts, round_keys(len(pts)), g, spread - 1.0)
+    if not finite:
+        raise InvalidSizeError("could not derive a size from the boundary")
+    return SizeField(constant or 0.0, pts, u, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
