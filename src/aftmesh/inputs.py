@@ -42,6 +42,9 @@ __all__ = ["Domain", "to_domain"]
 # Two regions overlap when their common area exceeds this fraction of the smaller
 # one: below it the overlap is the rounding of a shared boundary, not a real overlap.
 REGION_OVERLAP = 1e-12
+# Up to this many polygons, their rings are taken one polygon at a time: shapely's
+# vectorized get_rings costs about 10 us however few there are.
+FEW_POLYGONS = 16
 
 
 def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
@@ -56,17 +59,34 @@ def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
     vertices.  Returns (vertices, segments, input edge of each segment, ring of each
     input edge, midpoint of each input edge, ring names); a ring of n vertices
     (closing one not counted) has n input edges, numbered on from the ring before."""
-    holes = shapely.get_num_interior_rings(polygons)
-    # get_rings is several times slower than taking the exterior rings when that is all
-    rings = shapely.get_rings(polygons) if holes.any() else shapely.get_exterior_ring(polygons)
+    rings, holes = _rings(polygons)
     coords, ring_of = shapely.get_coordinates(rings, return_index=True)
     pts, segs, edge, mid, ring, removed = ring_chains(
         coords, ring_of.astype(np.int64, copy=False), len(rings)
     )
-    ring_names = _ring_names(names, holes.tolist())
-    for r in np.flatnonzero(removed).tolist():
-        note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
+    ring_names = _ring_names(names, holes)
+    if removed.any():
+        for r in np.flatnonzero(removed).tolist():
+            note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
     return pts, segs, edge, ring, mid, ring_names
+
+
+def _rings(polygons: list[Polygon]) -> tuple[list | np.ndarray, list[int]]:
+    """Each polygon's exterior ring then its holes, and the number of holes of each."""
+    if len(polygons) <= FEW_POLYGONS:
+        rings: list = []
+        holes = []
+        for p in polygons:
+            inner = list(p.interiors)
+            rings.append(p.exterior)
+            rings.extend(inner)
+            holes.append(len(inner))
+        return rings, holes
+    n_holes = shapely.get_num_interior_rings(polygons)
+    # get_rings is several times slower than taking the exterior rings when that is all
+    if n_holes.any():
+        return shapely.get_rings(polygons), n_holes.tolist()
+    return shapely.get_exterior_ring(polygons), n_holes.tolist()
 
 
 def _ring_names(names: list[str], holes: list[int]) -> list[str]:
