@@ -222,6 +222,51 @@ cdef class Triangulation:
         _raise_for(&self.T, res)
         return merged_arr
 
+    def insert_pslg(self, const int64_t[::1] rounds, const int32_t[:, ::1] segments,
+                    bint from_hull):
+        """insert_points in BRIO order (rounds: _order.round_keys of the vertices),
+        then insert_segments on the segments (rows of input vertex indices, mapped to
+        the vertices they were merged into), then carve from the hull (or only the
+        ghosts), in one call without the GIL.  Returns (merged, number merged, number
+        of segments split at vertices on them); raises as those methods do."""
+        cdef Tri* T = &self.T
+        cdef int n = T.nv, m = segments.shape[0], i, k, res = 0, failed = -1
+        cdef int through = 0, n_merged = 0
+        if T.nt:
+            raise ValueError("insert_pslg starts the triangulation: it already has triangles")
+        if rounds.shape[0] != n or segments.shape[1] != 2:
+            raise ValueError("one round key per vertex and segments of two columns needed")
+        for i in range(m):
+            for k in range(2):
+                if not 0 <= segments[i, k] < n:
+                    raise ValueError(f"segments[{i}] = {list(segments[i])} refers to a "
+                                     f"vertex outside 0..{n - 1}")
+        merged_arr = np.empty(n, dtype=np.int32)
+        cdef int32_t* merged = _i32v(merged_arr)
+        with nogil:
+            for i in range(n):
+                merged[i] = i
+            res = brio_insert(T, T.xy, n, &rounds[0], merged) if n else 0
+            for i in range(n):
+                n_merged += merged[i] != i
+            for i in range(m):
+                if res < 0:
+                    break
+                res = insert_segment(T, merged[segments[i, 0]], merged[segments[i, 1]],
+                                     E_SEGMENT, i)
+                if res < 0:
+                    failed = i
+                else:
+                    through += res
+            if res >= 0:
+                res = carve_domain(T, NULL, 0, from_hull)
+        try:
+            _raise_for(T, res)
+        except CrossingError as err:
+            err.index = failed
+            raise
+        return merged_arr, n_merged, through
+
     def add_points(self, const double[:, ::1] points):
         """Append points as new vertices and insert them into the triangulation (which
         must have been started by insert_points).  Returns their vertex indices, or
@@ -421,6 +466,8 @@ cdef class Triangulation:
         work on a small mesh."""
         cdef Tri* T = &self.T
         cdef int ntri, nvo, ns, t
+        cdef int32_t* vmap
+        cdef int32_t* nbr
         cdef uint8_t* keep = <uint8_t*> malloc(max(T.nt, 1) * sizeof(uint8_t))
         cdef int32_t* tri_index = <int32_t*> malloc(max(T.nt, 1) * sizeof(int32_t))
         if keep == NULL or tri_index == NULL:
@@ -428,23 +475,28 @@ cdef class Triangulation:
             free(tri_index)
             raise MemoryError()
         try:
-            vmap_arr = np.full(T.nv, -1, dtype=np.int32)
+            vmap_arr = np.empty(T.nv, dtype=np.int32)
+            vmap = _i32v(vmap_arr)
+            for t in range(T.nv):
+                vmap[t] = -1
             for t in range(T.nt):
                 tri_index[t] = -1
             ntri = mark_output(T, include_exterior, keep)
             tris_arr = np.empty((ntri, 3), dtype=np.int32)
             regions_arr = np.empty(ntri, dtype=np.int32)
-            nvo = number_output(T, keep, tri_index, _i32v(vmap_arr), _i32v(tris_arr),
+            nvo = number_output(T, keep, tri_index, vmap, _i32v(tris_arr),
                                 _i32v(regions_arr))
             points_arr = np.empty((nvo, 2), dtype=np.float64)
-            output_points(T, _i32v(vmap_arr), _f64v(points_arr))
-            ns = output_edges(T, keep, tri_index, _i32v(vmap_arr), NULL, NULL, NULL)
-            nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
+            output_points(T, vmap, _f64v(points_arr))
+            ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
+            nbr_arr = np.empty((ntri, 3), dtype=np.int32)
+            nbr = _i32v(nbr_arr)
+            for t in range(3 * ntri):
+                nbr[t] = -1
             seg_arr = np.empty((ns, 2), dtype=np.int32)
             seg_ids = np.empty(ns, dtype=np.int32)
             if ntri:
-                output_edges(T, keep, tri_index, _i32v(vmap_arr), _i32v(nbr_arr),
-                             _i32v(seg_arr), _i32v(seg_ids))
+                output_edges(T, keep, tri_index, vmap, nbr, _i32v(seg_arr), _i32v(seg_ids))
         finally:
             free(keep)
             free(tri_index)
@@ -827,6 +879,7 @@ def background_field(const double[:, ::1] xy, const int64_t[::1] rounds, double[
     Triangulation.finite_triangles, and whether g is finite at every used point."""
     cdef int n = xy.shape[0], i, res = 0, ok, nt
     cdef int32_t* tv
+    cdef int32_t* merged
     cdef Tri T
     if xy.shape[1] != 2 or rounds.shape[0] != n or g.shape[0] != n:
         raise ValueError("xy, rounds and g must have one row per point")
@@ -841,7 +894,9 @@ def background_field(const double[:, ::1] xy, const int64_t[::1] rounds, double[
                 if res < 0:
                     break
             if res >= 0:
-                res = brio_insert(&T, &xy[0, 0], n, &rounds[0])
+                merged = <int32_t*> malloc(n * sizeof(int32_t))
+                res = brio_insert(&T, &xy[0, 0], n, &rounds[0], merged) if merged else ERR_NOMEM
+                free(merged)
         _raise_for(&T, res)
         tv_arr, nb_arr = _finite_arrays(&T)
         nt = len(tv_arr)
@@ -954,6 +1009,16 @@ def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):
     cdef double[::1] out = out_arr
     if n:
         shortest_edges_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0])
+    return out_arr
+
+
+def take_or_none(const int32_t[::1] table, const int32_t[::1] index):
+    """table[index] (int32), -1 where index is -1 (see take_into in inputs.pxi)."""
+    cdef Py_ssize_t m = index.shape[0]
+    out_arr = np.empty(m, dtype=np.int32)
+    if m and take_into(&table[0] if table.shape[0] else NULL, table.shape[0], &index[0], m,
+                       _i32v(out_arr)):
+        raise IndexError("an index is outside -1..len(table) - 1")
     return out_arr
 
 

@@ -96,16 +96,17 @@ cdef int limit_gradation_tris(int nv, int nt, const double* xy, const int32_t* t
     return res
 
 
-cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds) noexcept nogil:
+cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds,
+                     int32_t* merged) noexcept nogil:
     """Insert the n vertices of T (rows of xy) in the BRIO order of _order.brio_order
-    (rounds | Hilbert keys, stably sorted); returns insert_points' code."""
+    (rounds | Hilbert keys, stably sorted); merged as insert_points sets it (v, or
+    the earlier vertex at the same place).  Returns insert_points' code."""
     cdef int i, res
     cdef int64_t* keys = <int64_t*> malloc(n * sizeof(int64_t))
     cdef int64_t* order = <int64_t*> malloc(n * sizeof(int64_t))
     cdef int64_t* work = <int64_t*> malloc(n * sizeof(int64_t))
     cdef int32_t* order32 = <int32_t*> malloc(n * sizeof(int32_t))
-    cdef int32_t* merged = <int32_t*> malloc(n * sizeof(int32_t))
-    if keys == NULL or order == NULL or work == NULL or order32 == NULL or merged == NULL:
+    if keys == NULL or order == NULL or work == NULL or order32 == NULL:
         res = ERR_NOMEM
     else:
         hilbert_keys_into(xy, n, BRIO_HILBERT_BITS, keys)
@@ -120,5 +121,4 @@ cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds) noe
     free(order)
     free(work)
     free(order32)
-    free(merged)
     return res

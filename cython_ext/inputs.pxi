@@ -239,3 +239,18 @@ cdef void shortest_edges_into(const double* xy, Py_ssize_t n, const int32_t* seg
             out[a] = d
         if d < out[b]:
             out[b] = d
+
+
+cdef int take_into(const int32_t* table, Py_ssize_t n, const int32_t* index, Py_ssize_t m,
+                   int32_t* out) noexcept nogil:
+    """out[i] = table[index[i]], -1 where index[i] is -1 (the kernel's and the domain's
+    "none"); returns -1 if an index is outside -1..n-1 (nothing is read there), else 0."""
+    cdef Py_ssize_t i
+    for i in range(m):
+        if index[i] == -1:
+            out[i] = -1
+        elif 0 <= index[i] < n:
+            out[i] = table[index[i]]
+        else:
+            return -1
+    return 0

@@ -219,3 +219,51 @@ def test_background_field_is_the_triangulation_and_gradation_it_replaces(n):
     assert (tv == want_tv).all() and (nb == want_nb).all()
     assert got_g.tobytes() == want_g.tobytes()
     assert finite == bool(np.isfinite(want_g[used]).all())
+
+
+def _pslg_by_steps(xy, seg, from_hull):
+    tri = _kernel.Triangulation(xy)
+    merged = tri.insert_points(_order.brio_order(xy))
+    split = tri.insert_segments(np.ascontiguousarray(merged[seg], dtype=np.int32))
+    tri.carve(np.zeros((0, 2)), from_hull)
+    return tri, merged, split
+
+
+@pytest.mark.parametrize("from_hull", [True, False])
+@pytest.mark.parametrize("n", [4, 40, 400])
+def test_insert_pslg_is_the_insertions_and_carve_it_replaces(n, from_hull):
+    rng = np.random.default_rng(n)
+    ring = np.c_[np.cos(np.linspace(0, 2 * np.pi, n, endpoint=False)), np.zeros(n)]
+    ring[:, 1] = np.sin(np.linspace(0, 2 * np.pi, n, endpoint=False))
+    inner = rng.uniform(-0.5, 0.5, size=(n, 2)).round(1)  # repeats: merged points
+    xy = np.ascontiguousarray(np.r_[ring, inner, ring[:1]])  # and a repeated corner
+    seg = np.c_[np.arange(n), (np.arange(n) + 1) % n].astype(np.int32)
+    seg = np.r_[seg, [[n, n + 1], [2 * n, 1]]].astype(np.int32)  # one ends at the copy
+    want, want_merged, want_split = _pslg_by_steps(xy, seg, from_hull)
+    got = _kernel.Triangulation(xy)
+    merged, n_merged, split = got.insert_pslg(_order.round_keys(len(xy)), seg, from_hull)
+    assert (merged == want_merged).all() and split == want_split
+    assert n_merged == int((want_merged != np.arange(len(xy))).sum()) > 0
+    for name, value in want.raw().items():
+        assert (got.raw()[name] == value).all(), name
+
+
+def test_insert_pslg_names_the_crossing_segment():
+    xy = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=np.float64)
+    seg = np.array([[0, 2], [1, 3]], dtype=np.int32)
+    with pytest.raises(_kernel.CrossingError) as info:
+        _kernel.Triangulation(xy).insert_pslg(_order.round_keys(4), seg, True)
+    assert info.value.index == 1 and info.value.blocker_segment == 0
+
+
+@given(st.lists(st.integers(-1, 4), max_size=10))
+def test_take_or_none_is_the_lookup_with_minus_one_for_none(index):
+    table = np.array([7, -1, 3, 0, 9], dtype=np.int32)
+    idx = np.array(index, dtype=np.int32)
+    want = np.where(idx < 0, -1, table[np.maximum(idx, 0)])
+    assert (_kernel.take_or_none(table, idx) == want).all()
+
+
+def test_take_or_none_refuses_an_index_outside_the_table():
+    with pytest.raises(IndexError):
+        _kernel.take_or_none(np.zeros(3, dtype=np.int32), np.array([0, 3], dtype=np.int32))

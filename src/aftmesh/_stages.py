@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import shortest_edges, size_field_count
+from ._kernel import shortest_edges, size_field_count, take_or_none
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
@@ -269,10 +269,9 @@ def refine(kernel, dom: Domain, opts: Options) -> dict | None:
 def _lookup(table: np.ndarray, index: np.ndarray) -> np.ndarray:
     """table[index] as int32, -1 where index is -1 (the kernel's and the domain's
     "none"; no index is below that)."""
-    out = np.empty(len(table) + 1, dtype=np.int32)
-    out[:-1] = table
-    out[-1] = -1
-    return out[index]
+    return take_or_none(
+        np.ascontiguousarray(table, dtype=np.int32), np.ascontiguousarray(index, dtype=np.int32)
+    )
 
 
 def assemble(
