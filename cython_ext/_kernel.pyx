@@ -1022,6 +1022,15 @@ def take_or_none(const int32_t[::1] table, const int32_t[::1] index):
     return out_arr
 
 
+def bounding_box(const double[:, ::1] xy):
+    """((xmin, ymin), (xmax, ymax)) of the points (finite, at least one) as floats."""
+    cdef double box[4]
+    if xy.shape[0] == 0 or xy.shape[1] != 2:
+        raise ValueError("bounding_box needs an (n, 2) array with n > 0")
+    box_of(&xy[0, 0], xy.shape[0], box)
+    return (box[0], box[1]), (box[2], box[3])
+
+
 def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits=16):
     """The stable argsort (int32) of rounds | hilbert_keys(xy, bits): the BRIO order
     of _order.brio_order in one call."""

@@ -254,3 +254,15 @@ cdef int take_into(const int32_t* table, Py_ssize_t n, const int32_t* index, Py_
         else:
             return -1
     return 0
+
+
+cdef void box_of(const double* xy, Py_ssize_t n, double* box) noexcept nogil:
+    """box = (xmin, ymin, xmax, ymax) of the n points (n > 0, finite)."""
+    cdef Py_ssize_t i
+    box[0] = box[2] = xy[0]
+    box[1] = box[3] = xy[1]
+    for i in range(1, n):
+        box[0] = min(box[0], xy[2 * i])
+        box[1] = min(box[1], xy[2 * i + 1])
+        box[2] = max(box[2], xy[2 * i])
+        box[3] = max(box[3], xy[2 * i + 1])

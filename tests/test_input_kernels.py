@@ -267,3 +267,10 @@ def test_take_or_none_is_the_lookup_with_minus_one_for_none(index):
 def test_take_or_none_refuses_an_index_outside_the_table():
     with pytest.raises(IndexError):
         _kernel.take_or_none(np.zeros(3, dtype=np.int32), np.array([0, 3], dtype=np.int32))
+
+
+@given(st.lists(st.tuples(coordinate, coordinate), min_size=1, max_size=12))
+def test_bounding_box_is_the_numpy_minimum_and_maximum(rows):
+    xy = np.array(rows, dtype=np.float64)
+    lo, hi = _kernel.bounding_box(xy)
+    assert lo == tuple(xy.min(axis=0)) and hi == tuple(xy.max(axis=0))

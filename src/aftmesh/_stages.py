@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import shortest_edges, size_field_count, take_or_none
+from ._kernel import bounding_box, shortest_edges, size_field_count, take_or_none
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
@@ -95,8 +95,7 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
     never asks for more than that edge there."""
     if isinstance(size, np.ndarray) and size.ndim == 0:
         size = size.item()
-    lo = dom.vertices.min(axis=0)
-    hi = dom.vertices.max(axis=0)
+    lo, hi = bounding_box(np.ascontiguousarray(dom.vertices, dtype=np.float64))
     if isinstance(size, (list, tuple, np.ndarray)):
         if dom.polygons is None:
             raise InvalidSizeError("a list of sizes needs a list of region polygons as the domain")
@@ -111,7 +110,7 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
         field = make_size_field(size, (lo, hi), verts, shortest, gradation)
     else:
         field = make_size_field(size, (lo, hi), gradation=gradation)
-    area = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
+    area = dom.area or max(hi[0] - lo[0], 1e-300) * max(hi[1] - lo[1], 1e-300)
     expected = expected_triangles(field, area, gradation)
     if not expected <= MAX_TRIANGLES:
         raise InvalidSizeError(
