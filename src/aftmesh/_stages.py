@@ -72,7 +72,8 @@ def _progress_callback(progress, expected_triangles: int):
     if callable(progress):
         return progress
     if progress is None:
-        progress = sys.stderr.isatty() and expected_triangles > PROGRESS_MIN_TRIANGLES
+        # the size first: isatty is a system call, and most meshes are small
+        progress = expected_triangles > PROGRESS_MIN_TRIANGLES and sys.stderr.isatty()
     return _ProgressBar(sys.stderr) if progress else None
 
 
