@@ -1,14 +1,19 @@
 """The threads backend of ``generate_many`` / ``imap_many``.
 
-Worker threads take the next domain themselves and put each result on a queue, so
-the calling thread only collects results: it holds the GIL for a few microseconds per
-domain, which the workers' Python glue around the GIL-free kernel needs.  (A
+Worker threads take the next domain themselves and queue each result, so the calling
+thread only collects results: it holds the GIL for a few microseconds per domain,
+which the workers' Python glue around the GIL-free kernel needs.  (A
 ``concurrent.futures`` pool spends about a hundred and fifty microseconds of the
-calling thread's GIL time per small domain on submitting and waiting.)
+calling thread's GIL time per small domain on submitting and waiting.)  When nobody
+watches the results one by one (``generate_many`` without a progress callback), the
+calling thread is woken once per batch of results, not once per domain: each wake-up
+is a GIL hand-off that a worker waits through.
 """
 
 from __future__ import annotations
 
+import collections
+import itertools
 import queue
 import threading
 from collections.abc import Callable, Iterator
@@ -16,19 +21,20 @@ from typing import Any
 
 
 class _Source:
-    """The shared iterable of ``(index, domain, size)``, read under a lock, with a
-    bounded number of domains taken but not yet handed to the caller."""
+    """The shared iterable of ``(index, domain, size)``, read under a lock; with a
+    window, at most that many domains taken but not yet handed to the caller."""
 
-    def __init__(self, items, window: int):
+    def __init__(self, items, window: int | None):
         self._items = iter(items)
         self._lock = threading.Lock()
-        self._slots = threading.Semaphore(window)
+        self._slots = None if window is None else threading.Semaphore(window)
         self.stopped = False
 
     def take(self):
         """The next item; None when there is none or the run was stopped.  Blocks
         while `window` results wait for the caller."""
-        self._slots.acquire()
+        if self._slots is not None:
+            self._slots.acquire()
         with self._lock:
             if self.stopped:
                 return None
@@ -42,21 +48,38 @@ class _Source:
                 raise
 
     def handed_out(self) -> None:
-        self._slots.release()
+        if self._slots is not None:
+            self._slots.release()
 
     def stop(self, workers: int) -> None:
         with self._lock:
             self.stopped = True
-        for _ in range(workers):  # wake workers waiting for a slot
-            self._slots.release()
+        if self._slots is not None:
+            for _ in range(workers):  # wake workers waiting for a slot
+                self._slots.release()
 
 
-# what a worker puts on the queue when it stops: (_DONE, None), or (_DONE, error)
-# when reading the domains raised
-_DONE = -1
+class _Results:
+    """Finished results (a deque: append and popleft need no lock) and the wake-ups
+    of the caller: one per `batch` results, and one when a worker stops (with the
+    error it stopped on, if reading the domains raised)."""
+
+    def __init__(self, batch: int):
+        self.done: collections.deque = collections.deque()
+        self.wake: queue.SimpleQueue = queue.SimpleQueue()
+        self._batch = batch
+        self._count = itertools.count(1)
+
+    def put(self, item) -> None:
+        self.done.append(item)
+        if next(self._count) % self._batch == 0:
+            self.wake.put(None)
+
+    def worker_stopped(self, error: BaseException | None) -> None:
+        self.wake.put((error,))
 
 
-def _work(source: _Source, results: queue.SimpleQueue, mesh_one: Callable, options: dict):
+def _work(source: _Source, results: _Results, mesh_one: Callable, options: dict):
     error = None
     try:
         while (item := source.take()) is not None:
@@ -65,17 +88,19 @@ def _work(source: _Source, results: queue.SimpleQueue, mesh_one: Callable, optio
     except BaseException as err:  # noqa: BLE001  (raised again by the caller)
         error = err
     finally:
-        results.put((_DONE, error))
+        results.worker_stopped(error)
 
 
 def run_threads(
-    items, options: dict, workers: int, window: int, mesh_one: Callable
+    items, options: dict, workers: int, mesh_one: Callable, window: int | None, batch: int = 1
 ) -> Iterator[tuple[int, Any]]:
-    """``(index, result)`` as the `workers` threads finish them; `mesh_one(i, domain,
-    size, options)` makes a result.  Closing the generator stops the workers after
-    the domains they are meshing."""
+    """``(index, result)`` as the `workers` threads finish them (handed over in
+    batches of `batch`); `mesh_one(i, domain, size, options)` makes a result.
+    Closing the generator stops the workers after the domains they are meshing."""
     source = _Source(items, window)
-    results: queue.SimpleQueue = queue.SimpleQueue()
+    # a worker blocked on a full window must have woken the caller: batches only
+    # without one
+    results = _Results(batch if window is None else 1)
     threads = [
         threading.Thread(
             target=_work, args=(source, results, mesh_one, options), name=f"aftmesh_{k}"
@@ -87,14 +112,15 @@ def run_threads(
     running = workers
     try:
         while running:
-            index, result = results.get()
-            if index == _DONE:
+            token = results.wake.get()
+            if token is not None:  # a worker stopped
                 running -= 1
-                if result is not None:
-                    raise result
-                continue
-            source.handed_out()
-            yield index, result
+                if token[0] is not None:
+                    raise token[0]
+            while results.done:
+                item = results.done.popleft()
+                source.handed_out()
+                yield item
     finally:
         source.stop(workers)
         for t in threads:

@@ -50,6 +50,10 @@ _ERRORS = ("raise", "collect")
 # flight per worker (Dask): enough that no worker waits for the driver, few enough
 # that a lazy iterable of domains is not read far ahead.
 IN_FLIGHT_PER_WORKER = 4
+# generate_many without a progress callback wakes the calling thread once per this
+# many finished domains (each wake-up takes the GIL from a worker); a failing domain
+# is then raised at most this many domains late.
+RESULTS_PER_WAKE = 32
 
 
 @dataclass(frozen=True)
@@ -186,9 +190,13 @@ def _serial(items, options, chunksize) -> Iterator[tuple[int, Any]]:
         yield i, _mesh_one(i, d, s, options)
 
 
-def _threads(items, options, workers, chunksize) -> Iterator[tuple[int, Any]]:
-    """Worker threads that take the domains themselves, a bounded window ahead."""
-    return run_threads(items, options, workers, workers * IN_FLIGHT_PER_WORKER, _mesh_one)
+def _threads(items, options, workers, batched) -> Iterator[tuple[int, Any]]:
+    """Worker threads that take the domains themselves: a bounded window ahead, or,
+    `batched` (all results wanted at once), unbounded with results handed over in
+    batches."""
+    if batched:
+        return run_threads(items, options, workers, _mesh_one, None, RESULTS_PER_WAKE)
+    return run_threads(items, options, workers, _mesh_one, workers * IN_FLIGHT_PER_WORKER)
 
 
 def _batches(items, chunksize):
@@ -266,6 +274,14 @@ def imap_many(
     >>> sorted(i for i, mesh in aftmesh.imap_many(squares, size=0.5, workers=2))
     [0, 1, 2]
     """
+    run = (scheduler, workers, client, chunksize, options)
+    return _imap(domains, size, run, errors, progress, batched=False)
+
+
+def _imap(domains, size, run, errors, progress, batched):
+    """imap_many's stream; `batched`: the caller wants all results at once (see
+    _threads)."""
+    scheduler, workers, client, chunksize, options = run
     if client is not None and scheduler == "threads":
         scheduler = "dask"
     _check(scheduler, errors, workers, chunksize, client)
@@ -273,14 +289,16 @@ def imap_many(
     items = _pairs(domains, size)
     if scheduler == "dask":
         client = dask_client(client)
-    return _results(items, total, scheduler, workers, client, errors, progress, chunksize, options)
+    run = (scheduler, workers, client, chunksize, options)
+    return _results(items, total, run, errors, progress, batched)
 
 
-def _results(items, total, scheduler, workers, client, errors, progress, chunksize, options):
+def _results(items, total, run, errors, progress, batched):
+    scheduler, workers, client, chunksize, options = run
     if scheduler == "serial":
         stream = _serial(items, options, chunksize)
     elif scheduler == "threads":
-        stream = _threads(items, options, workers or os.cpu_count() or 1, chunksize)
+        stream = _threads(items, options, workers or os.cpu_count() or 1, batched)
     else:
         stream = _dask(items, options, client, chunksize or 1)
     for done, (index, result) in enumerate(stream, start=1):
@@ -371,17 +389,6 @@ def generate_many(
     >>> out[1].index, isinstance(out[1].error, aftmesh.InvalidDomainError)
     (1, True)
     """
-    out: dict[int, Any] = dict(
-        imap_many(
-            domains,
-            size,
-            workers=workers,
-            scheduler=scheduler,
-            client=client,
-            errors=errors,
-            progress=progress,
-            chunksize=chunksize,
-            **options,
-        )
-    )
+    run = (scheduler, workers, client, chunksize, options)
+    out: dict[int, Any] = dict(_imap(domains, size, run, errors, progress, progress is None))
     return [out[i] for i in range(len(out))]
