@@ -165,8 +165,21 @@ LOCATION_VALUES = dict(IN_TRIANGLE=LOC_IN_TRIANGLE, ON_EDGE=LOC_ON_EDGE,
                        ON_VERTEX=LOC_ON_VERTEX, OUTSIDE=LOC_OUTSIDE)
 EDGE_FLAG_VALUES = dict(SEGMENT=E_SEGMENT, FIXED=E_FIXED)
 
+# Kernel routines on fewer items than this run with the GIL held: they take a few
+# microseconds, less than a GIL hand-off costs when another thread waits for it (it is
+# woken for nothing, or takes the GIL in the middle of this thread's Python work).
+cdef enum:
+    NOGIL_MIN_ITEMS = 1024
+
 # Coordinates (besides 0) for which orient2d and incircle are exact (predicates.pxi).
 EXACT_COORDINATE_RANGE = (EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
+
+
+cdef void _add_vertices(Tri* T, const double* xy, Py_ssize_t n) noexcept nogil:
+    """Append the n points as vertices (room for them was reserved by tri_init)."""
+    cdef Py_ssize_t i
+    for i in range(n):
+        add_vertex(T, xy[2 * i], xy[2 * i + 1])
 
 
 cdef class Triangulation:
@@ -182,15 +195,17 @@ cdef class Triangulation:
     cdef object progress        # keeps alive the callable A.progress points to
 
     def __cinit__(self, const double[:, ::1] points, int nt_hint=0):
-        cdef int n = points.shape[0], i
+        cdef int n = points.shape[0]
         if points.shape[1] != 2:
             raise ValueError("points must have shape (n, 2)")
         if tri_init(&self.T, n + 16, max(nt_hint, 2 * n + 16)) or aft_init(&self.A):
             raise MemoryError()
         self.vis_edge = NONE
-        with nogil:
-            for i in range(n):
-                add_vertex(&self.T, points[i, 0], points[i, 1])
+        if n >= NOGIL_MIN_ITEMS:
+            with nogil:
+                _add_vertices(&self.T, &points[0, 0], n)
+        elif n:
+            _add_vertices(&self.T, &points[0, 0], n)
 
     def __dealloc__(self):
         # an exception kept from a signal handler but never raised: drop it
@@ -359,7 +374,10 @@ cdef class Triangulation:
         best_arr = np.zeros(max(T.nt, 1), dtype=np.int32)
         cdef int32_t[::1] comp = comp_arr
         cdef int32_t[::1] best = best_arr
-        with nogil:
+        if T.nt >= NOGIL_MIN_ITEMS:
+            with nogil:
+                nc = domain_components(T, &comp[0] if T.nt else NULL, &best[0])
+        else:
             nc = domain_components(T, &comp[0] if T.nt else NULL, &best[0])
         _raise_for(T, nc)
         corners_arr = np.empty((nc, 3, 2), dtype=np.float64)
@@ -935,12 +953,14 @@ def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t 
     cdef double[:, ::1] mid = mid_arr, pts = pts_arr
     cdef int64_t[::1] ring = ring_arr, edge = edge_arr, removed = removed_arr
     cdef int64_t[:, ::1] seg = seg_arr
-    if n_open:
+    k = 0
+    if n_open >= NOGIL_MIN_ITEMS:
         with nogil:
             k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
                                  &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
-    else:
-        k = 0
+    elif n_open:
+        k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
+                             &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
     return pts_arr[:k], seg_arr[:k], edge_arr[:k], mid_arr, ring_arr, removed_arr
 
 
@@ -977,7 +997,10 @@ def unique_points(const double[:, ::1] xy):
     cdef int64_t[::1] first = first_arr, work = work_arr, inverse = inverse_arr
     if n == 0:
         return first_arr, inverse_arr
-    with nogil:
+    if n >= NOGIL_MIN_ITEMS:
+        with nogil:
+            k = unique_points_into(&xy[0, 0], n, &first[0], &work[0], &inverse[0])
+    else:
         k = unique_points_into(&xy[0, 0], n, &first[0], &work[0], &inverse[0])
     return None if k < 0 else (first_arr[:k], inverse_arr)
 
@@ -1034,7 +1057,7 @@ def bounding_box(const double[:, ::1] xy):
 def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits=16):
     """The stable argsort (int32) of rounds | hilbert_keys(xy, bits): the BRIO order
     of _order.brio_order in one call."""
-    cdef Py_ssize_t n = xy.shape[0], i
+    cdef Py_ssize_t n = xy.shape[0]
     if rounds.shape[0] != n:
         raise ValueError("xy and rounds differ in length")
     if not 1 <= bits <= 31:
@@ -1047,14 +1070,24 @@ def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits
     cdef int32_t[::1] out = out_arr
     if n == 0:
         return out_arr
-    with nogil:
-        hilbert_keys_into(&xy[0, 0], n, bits, &keys[0])
-        for i in range(n):
-            keys[i] |= rounds[i]
-        stable_order(&keys[0], _key_less, n, &order[0], &work[0])
-        for i in range(n):
-            out[i] = <int32_t> order[i]
+    if n >= NOGIL_MIN_ITEMS:
+        with nogil:
+            _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
+    else:
+        _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
     return out_arr
+
+
+cdef void _brio_order(const double* xy, const int64_t* rounds, Py_ssize_t n, int bits,
+                      int64_t* keys, int64_t* order, int64_t* work,
+                      int32_t* out) noexcept nogil:
+    cdef Py_ssize_t i
+    hilbert_keys_into(xy, n, bits, keys)
+    for i in range(n):
+        keys[i] |= rounds[i]
+    stable_order(keys, _key_less, n, order, work)
+    for i in range(n):
+        out[i] = <int32_t> order[i]
 
 
 cdef int _check_discretize(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
@@ -1119,6 +1152,7 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     cdef double total = 0.0
     cdef double* pts
     cdef uint8_t* keep
+    cdef bint release
     _check_discretize(vertices, segments, max_samples)
     if source.shape[0] != m:
         raise ValueError("segments and source differ in length")
@@ -1128,21 +1162,31 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     try:
         if cum == NULL or pieces == NULL:
             raise MemoryError()
-        if m:
+        # a background makes every sample a walk; with a constant, small inputs are
+        # a few microseconds (see NOGIL_MIN_ITEMS)
+        release = S.nt > 0 or m >= NOGIL_MIN_ITEMS
+        if release and m:
             with nogil:
                 total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
                                           max_samples, cum, pieces, &n_pts)
+        elif m:
+            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
+                                      max_samples, cum, pieces, &n_pts)
         if not total <= max_pieces:
             return total, None, None
         pts_arr = np.empty((n_pts, 2), dtype=np.float64)
         keep_arr = np.empty(n_pts, dtype=np.uint8)
         pts = _f64v(pts_arr)
         keep = _u8v(keep_arr)
-        if n_pts:
+        if n_pts and release:
             with nogil:
                 discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
                                   cum, pieces, pts, NULL)
                 kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
+        elif n_pts:
+            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                              cum, pieces, pts, NULL)
+            kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
         # each split segment: one piece more than its kept points
         v_out = np.empty((nv + kept, 2), dtype=np.float64)
         s_out = np.empty((m + kept, 2), dtype=np.int32)

@@ -274,3 +274,11 @@ def test_bounding_box_is_the_numpy_minimum_and_maximum(rows):
     xy = np.array(rows, dtype=np.float64)
     lo, hi = _kernel.bounding_box(xy)
     assert lo == tuple(xy.min(axis=0)) and hi == tuple(xy.max(axis=0))
+
+
+def test_unique_points_of_many_points_is_numpy_unique():
+    # above the kernel's NOGIL_MIN_ITEMS: the same routine without the GIL
+    pts = np.random.default_rng(7).integers(0, 40, size=(5000, 2)).astype(np.float64)
+    want, want_inverse = np.unique(pts, axis=0, return_inverse=True)
+    got, inverse = unique_rows(pts)
+    assert got.tobytes() == want.tobytes() and (inverse == want_inverse.reshape(-1)).all()
