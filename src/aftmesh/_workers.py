@@ -101,9 +101,15 @@ def run_threads(
     # a worker blocked on a full window must have woken the caller: batches only
     # without one
     results = _Results(batch if window is None else 1)
+    # daemon threads: every way out of this generator joins them, but one left
+    # suspended until the interpreter exits would otherwise keep it from exiting
+    # (its workers wait for window slots that nobody frees)
     threads = [
         threading.Thread(
-            target=_work, args=(source, results, mesh_one, options), name=f"aftmesh_{k}"
+            target=_work,
+            args=(source, results, mesh_one, options),
+            name=f"aftmesh_{k}",
+            daemon=True,
         )
         for k in range(workers)
     ]
