@@ -357,21 +357,26 @@ def make_size_field(
         lengths = np.concatenate([edges, lengths])
     pts = np.ascontiguousarray(pts)
     if callable(size):
-        u = _evaluate(size, pts[:, 0], pts[:, 1])
-        _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
-    else:
-        u = np.full(len(pts), np.inf if constant is None else constant)
-        return _numbers_field(constant, pts, u, lengths, gradation)
+        return _callable_field(size, bounds, pts, lengths, gradation)
+    u = np.full(len(pts), np.inf if constant is None else constant)
+    return _numbers_field(constant, pts, u, lengths, gradation)
+
+
+def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradation):
+    """make_size_field for a callable: sampled at the background's vertices and then
+    where interpolation misses it (_resolve_callable), gradation-limited when asked,
+    with the boundary's sizes spread as in _numbers_field."""
+    u = _evaluate(size, pts[:, 0], pts[:, 1])
+    _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
     tri = _kernel.Triangulation(pts)
     tri.insert_points(brio_order(pts))
-    if callable(size):
-        pts, u = _resolve_callable(size, tri, pts, u, bounds)
-        lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
+    pts, u = _resolve_callable(size, tri, pts, u, bounds)
+    lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
     tv, nb = tri.finite_triangles()
     used = np.zeros(len(pts), dtype=bool)
     used[tv.ravel()] = True  # a point merged into an earlier one is in no triangle
     w = np.ascontiguousarray(u, dtype=np.float64)
-    if callable(size) and gradation > 1.0:
+    if gradation > 1.0:
         w = w.copy()
         _kernel.limit_gradation_mesh(pts, tv, w, float(gradation - 1.0))
     # the boundary's sizes spread at the user's gradation, or the default one if the
@@ -385,12 +390,13 @@ def make_size_field(
     if not np.isfinite(g[used]).all():
         raise InvalidSizeError("could not derive a size from the boundary")
     g[~used] = np.inf  # never read: only the triangles' vertices are
-    return SizeField(constant or 0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
+    return SizeField(0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
 
 
 def _numbers_field(constant, pts: np.ndarray, u: np.ndarray, lengths: np.ndarray, gradation):
     """make_size_field without a callable: the background, the boundary's sizes and
-    their gradation in one kernel call (the same steps as the callable's path)."""
+    their gradation in one kernel call (the steps of _callable_field without the
+    sampling; see there for the gradation rules)."""
     spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
     g = np.minimum(u, lengths) if gradation > 1.0 else lengths.copy()
     tv, nb, finite = _kernel.background_field(pts, round_keys(len(pts)), g, spread - 1.0)
