@@ -1054,7 +1054,8 @@ def bounding_box(const double[:, ::1] xy):
     return (box[0], box[1]), (box[2], box[3])
 
 
-def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds, int bits=16):
+def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds,
+                    int bits=BRIO_HILBERT_BITS):
     """The stable argsort (int32) of rounds | hilbert_keys(xy, bits): the BRIO order
     of _order.brio_order in one call."""
     cdef Py_ssize_t n = xy.shape[0]
