@@ -18,6 +18,7 @@ hold the ``nogil`` kernels:
 * refine.pxi         the minimum-angle pass (Delaunay refinement)
 * inputs.pxi         ring clean-up, coordinate and segment checks of the input
 * discretize.pxi     input segments split by the integral of 1/size
+* background.pxi     a size field's background triangulation and gradation, at once
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -28,6 +29,7 @@ from halfedge.pxd on failure); the methods here turn codes into exceptions.
 """
 from halfedge cimport *
 from aft cimport Aft
+from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBuffer_Release, PyObject_GetBuffer
 from cpython.ref cimport Py_XDECREF, PyObject
 from libc.stdlib cimport malloc, free
 
@@ -54,6 +56,7 @@ include "optimize.pxi"
 include "refine.pxi"
 include "inputs.pxi"
 include "discretize.pxi"
+include "background.pxi"
 
 
 class KernelError(RuntimeError):
@@ -124,6 +127,35 @@ cdef double* _f64(arr) except? NULL:
     return &v[0] if v.shape[0] else NULL
 
 
+# The same for arrays known to be fresh, C-contiguous and of that dtype (the
+# kernel's own outputs): the buffer is read without reshaping first.
+cdef int32_t* _i32v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef int32_t* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <int32_t*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)  # arr keeps the memory
+    return out
+
+
+cdef uint8_t* _u8v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef uint8_t* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <uint8_t*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)
+    return out
+
+
+cdef double* _f64v(object arr) except? NULL:
+    cdef Py_buffer view
+    cdef double* out
+    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
+    out = <double*> view.buf if view.len else NULL
+    PyBuffer_Release(&view)
+    return out
+
+
 # The named enums of halfedge.pxd, for src/aftmesh/_states.py (tests/test_states.py
 # checks that the IntEnums there hold these values).
 TRIANGLE_STATE_VALUES = dict(FREE=T_FREE, EXTERIOR=T_EXTERIOR, UNMESHED=T_UNMESHED,
@@ -133,8 +165,21 @@ LOCATION_VALUES = dict(IN_TRIANGLE=LOC_IN_TRIANGLE, ON_EDGE=LOC_ON_EDGE,
                        ON_VERTEX=LOC_ON_VERTEX, OUTSIDE=LOC_OUTSIDE)
 EDGE_FLAG_VALUES = dict(SEGMENT=E_SEGMENT, FIXED=E_FIXED)
 
+# Kernel routines on fewer items than this run with the GIL held: they take a few
+# microseconds, less than a GIL hand-off costs when another thread waits for it (it is
+# woken for nothing, or takes the GIL in the middle of this thread's Python work).
+cdef enum:
+    NOGIL_MIN_ITEMS = 1024
+
 # Coordinates (besides 0) for which orient2d and incircle are exact (predicates.pxi).
 EXACT_COORDINATE_RANGE = (EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
+
+
+cdef void _add_vertices(Tri* T, const double* xy, Py_ssize_t n) noexcept nogil:
+    """Append the n points as vertices (room for them was reserved by tri_init)."""
+    cdef Py_ssize_t i
+    for i in range(n):
+        add_vertex(T, xy[2 * i], xy[2 * i + 1])
 
 
 cdef class Triangulation:
@@ -150,15 +195,17 @@ cdef class Triangulation:
     cdef object progress        # keeps alive the callable A.progress points to
 
     def __cinit__(self, const double[:, ::1] points, int nt_hint=0):
-        cdef int n = points.shape[0], i
+        cdef int n = points.shape[0]
         if points.shape[1] != 2:
             raise ValueError("points must have shape (n, 2)")
         if tri_init(&self.T, n + 16, max(nt_hint, 2 * n + 16)) or aft_init(&self.A):
             raise MemoryError()
         self.vis_edge = NONE
-        with nogil:
-            for i in range(n):
-                add_vertex(&self.T, points[i, 0], points[i, 1])
+        if n >= NOGIL_MIN_ITEMS:
+            with nogil:
+                _add_vertices(&self.T, &points[0, 0], n)
+        elif n:
+            _add_vertices(&self.T, &points[0, 0], n)
 
     def __dealloc__(self):
         # an exception kept from a signal handler but never raised: drop it
@@ -176,19 +223,64 @@ cdef class Triangulation:
         """Insert the vertices in `order` (a spatially coherent order makes the walks
         short).  Returns an int32 array `merged`: merged[v] == v for inserted vertices,
         or the index of the earlier vertex at exactly the same place."""
-        cdef int n = self.T.nv, res = 0
+        cdef int n = self.T.nv, res = 0, i
         cdef int m = order.shape[0]
         merged_arr = np.arange(n, dtype=np.int32)
         if m == 0:
             return merged_arr
-        order_np = np.asarray(order)
-        if order_np.min() < 0 or order_np.max() >= n:
-            raise ValueError(f"order holds a vertex outside 0..{n - 1}")
-        cdef int32_t* merged = _i32(merged_arr)
+        for i in range(m):
+            if not 0 <= order[i] < n:
+                raise ValueError(f"order holds a vertex outside 0..{n - 1}")
+        cdef int32_t* merged = _i32v(merged_arr)
         with nogil:
             res = insert_points(&self.T, &order[0], m, merged)
         _raise_for(&self.T, res)
         return merged_arr
+
+    def insert_pslg(self, const int64_t[::1] rounds, const int32_t[:, ::1] segments,
+                    bint from_hull):
+        """insert_points in BRIO order (rounds: _order.round_keys of the vertices),
+        then insert_segments on the segments (rows of input vertex indices, mapped to
+        the vertices they were merged into), then carve from the hull (or only the
+        ghosts), in one call without the GIL.  Returns (merged, number merged, number
+        of segments split at vertices on them); raises as those methods do."""
+        cdef Tri* T = &self.T
+        cdef int n = T.nv, m = segments.shape[0], i, k, res = 0, failed = -1
+        cdef int through = 0, n_merged = 0
+        if T.nt:
+            raise ValueError("insert_pslg starts the triangulation: it already has triangles")
+        if rounds.shape[0] != n or segments.shape[1] != 2:
+            raise ValueError("one round key per vertex and segments of two columns needed")
+        for i in range(m):
+            for k in range(2):
+                if not 0 <= segments[i, k] < n:
+                    raise ValueError(f"segments[{i}] = {list(segments[i])} refers to a "
+                                     f"vertex outside 0..{n - 1}")
+        merged_arr = np.empty(n, dtype=np.int32)
+        cdef int32_t* merged = _i32v(merged_arr)
+        with nogil:
+            for i in range(n):
+                merged[i] = i
+            res = brio_insert(T, T.xy, n, &rounds[0], merged) if n else 0
+            for i in range(n):
+                n_merged += merged[i] != i
+            for i in range(m):
+                if res < 0:
+                    break
+                res = insert_segment(T, merged[segments[i, 0]], merged[segments[i, 1]],
+                                     E_SEGMENT, i)
+                if res < 0:
+                    failed = i
+                else:
+                    through += res
+            if res >= 0:
+                res = carve_domain(T, NULL, 0, from_hull)
+        try:
+            _raise_for(T, res)
+        except CrossingError as err:
+            err.index = failed
+            raise
+        return merged_arr, n_merged, through
 
     def add_points(self, const double[:, ::1] points):
         """Append points as new vertices and insert them into the triangulation (which
@@ -214,26 +306,7 @@ cdef class Triangulation:
         """Every live finite triangle, whatever its state: (tv (t, 3) of kernel vertex
         indices, counter-clockwise; nb (t, 3), the triangle across the edge opposite
         vertex k, -1 at the hull)."""
-        cdef Tri* T = &self.T
-        cdef int t, k, n = 0, u
-        index_arr = np.full(T.nt, -1, dtype=np.int32)
-        cdef int32_t[::1] index = index_arr
-        for t in range(T.nt):
-            if T.tstate[t] != T_FREE and not is_ghost(T, t):
-                index[t] = n
-                n += 1
-        tv_arr = np.empty((n, 3), dtype=np.int32)
-        nb_arr = np.empty((n, 3), dtype=np.int32)
-        cdef int32_t[:, ::1] tv = tv_arr
-        cdef int32_t[:, ::1] nb = nb_arr
-        for t in range(T.nt):
-            if index[t] >= 0:
-                for k in range(3):
-                    tv[index[t], k] = T.tv[3 * t + k]
-                    # the edge opposite vertex k is half-edge 3t + k + 1
-                    u = index[T.twin[3 * t + (k + 1) % 3] // 3]
-                    nb[index[t], k] = u
-        return tv_arr, nb_arr
+        return _finite_arrays(&self.T)
 
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
                         int first_id=0):
@@ -301,7 +374,10 @@ cdef class Triangulation:
         best_arr = np.zeros(max(T.nt, 1), dtype=np.int32)
         cdef int32_t[::1] comp = comp_arr
         cdef int32_t[::1] best = best_arr
-        with nogil:
+        if T.nt >= NOGIL_MIN_ITEMS:
+            with nogil:
+                nc = domain_components(T, &comp[0] if T.nt else NULL, &best[0])
+        else:
             nc = domain_components(T, &comp[0] if T.nt else NULL, &best[0])
         _raise_for(T, nc)
         corners_arr = np.empty((nc, 3, 2), dtype=np.float64)
@@ -403,28 +479,45 @@ cdef class Triangulation:
         (t, 3) with neighbors[i, k] across the edge opposite vertex k (-1: none),
         segments (s, 2) (constrained edges of the domain, each once), segment_ids (s,)
         the input segment each is a piece of (see insert_segments; -1: none), regions
-        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output)."""
+        (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output).
+        The scratch arrays are C buffers: numpy's cost per array would exceed the
+        work on a small mesh."""
         cdef Tri* T = &self.T
-        cdef int ntri, nvo, ns
-        keep_arr = np.zeros(T.nt, dtype=np.uint8)
-        tri_index_arr = np.full(T.nt, -1, dtype=np.int32)
-        vmap_arr = np.full(T.nv, -1, dtype=np.int32)
-        cdef uint8_t* keep = _u8(keep_arr)
-        cdef int32_t* tri_index = _i32(tri_index_arr)
-        cdef int32_t* vmap = _i32(vmap_arr)
-        ntri = mark_output(T, include_exterior, keep)
-        tris_arr = np.empty((ntri, 3), dtype=np.int32)
-        regions_arr = np.empty(ntri, dtype=np.int32)
-        nvo = number_output(T, keep, tri_index, vmap, _i32(tris_arr), _i32(regions_arr))
-        points_arr = np.empty((nvo, 2), dtype=np.float64)
-        output_points(T, vmap, _f64(points_arr))
-        ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
-        nbr_arr = np.full((ntri, 3), -1, dtype=np.int32)
-        seg_arr = np.empty((ns, 2), dtype=np.int32)
-        seg_ids = np.empty(ns, dtype=np.int32)
-        if ntri:
-            output_edges(T, keep, tri_index, vmap, _i32(nbr_arr), _i32(seg_arr),
-                         _i32(seg_ids))
+        cdef int ntri, nvo, ns, t
+        cdef int32_t* vmap
+        cdef int32_t* nbr
+        cdef uint8_t* keep = <uint8_t*> malloc(max(T.nt, 1) * sizeof(uint8_t))
+        cdef int32_t* tri_index = <int32_t*> malloc(max(T.nt, 1) * sizeof(int32_t))
+        if keep == NULL or tri_index == NULL:
+            free(keep)
+            free(tri_index)
+            raise MemoryError()
+        try:
+            vmap_arr = np.empty(T.nv, dtype=np.int32)
+            vmap = _i32v(vmap_arr)
+            for t in range(T.nv):
+                vmap[t] = -1
+            for t in range(T.nt):
+                tri_index[t] = -1
+            ntri = mark_output(T, include_exterior, keep)
+            tris_arr = np.empty((ntri, 3), dtype=np.int32)
+            regions_arr = np.empty(ntri, dtype=np.int32)
+            nvo = number_output(T, keep, tri_index, vmap, _i32v(tris_arr),
+                                _i32v(regions_arr))
+            points_arr = np.empty((nvo, 2), dtype=np.float64)
+            output_points(T, vmap, _f64v(points_arr))
+            ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
+            nbr_arr = np.empty((ntri, 3), dtype=np.int32)
+            nbr = _i32v(nbr_arr)
+            for t in range(3 * ntri):
+                nbr[t] = -1
+            seg_arr = np.empty((ns, 2), dtype=np.int32)
+            seg_ids = np.empty(ns, dtype=np.int32)
+            if ntri:
+                output_edges(T, keep, tri_index, vmap, nbr, _i32v(seg_arr), _i32v(seg_ids))
+        finally:
+            free(keep)
+            free(tri_index)
         return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
                     segments=seg_arr, segment_ids=seg_ids,
                     regions=regions_arr, vertex_map=vmap_arr)
@@ -762,35 +855,78 @@ def limit_gradation_mesh(const double[:, ::1] xy, const int32_t[:, ::1] tv, doub
     max(0, |uv| - reach h[u]) along every edge of the triangles tv: the size grows by
     at most `rate` per unit of length along any path of edges (after holding for
     reach times itself)."""
-    cdef int nv = xy.shape[0], nt = tv.shape[0], t, k, a, b, res
+    cdef int nv = xy.shape[0], nt = tv.shape[0], t, k, res
     if h.shape[0] != nv:
         raise ValueError("h must have one value per vertex")
     if nt == 0 or nv == 0:
         return
-    start_arr = np.zeros(nv + 1, dtype=np.int32)
-    adj_arr = np.empty(6 * nt, dtype=np.int32)
-    fill_arr = np.empty(nv, dtype=np.int32)
-    cdef int32_t[::1] start = start_arr
-    cdef int32_t[::1] adj = adj_arr
-    cdef int32_t[::1] fill = fill_arr
+    for t in range(nt):
+        for k in range(3):
+            if not 0 <= tv[t, k] < nv:
+                raise ValueError(f"triangle {t} refers to a vertex outside 0..{nv - 1}")
     with nogil:
-        for t in range(nt):
-            for k in range(3):
-                start[tv[t, k] + 1] += 2
-        for a in range(nv):
-            start[a + 1] += start[a]
-            fill[a] = start[a]
-        for t in range(nt):
-            for k in range(3):
-                a = tv[t, k]
-                b = tv[t, (k + 1) % 3]
-                adj[fill[a]] = b
-                fill[a] += 1
-                adj[fill[b]] = a
-                fill[b] += 1
-        res = limit_gradation_graph(nv, &start[0], &adj[0], &xy[0, 0], &h[0], rate, reach)
+        res = limit_gradation_tris(nv, nt, &xy[0, 0], &tv[0, 0], &h[0], rate, reach)
     if res:
         raise MemoryError()
+
+
+cdef object _finite_arrays(Tri* T):
+    """(tv, nb) of the live finite triangles of T (see Triangulation.finite_triangles)."""
+    cdef int n
+    cdef int32_t* index = <int32_t*> malloc(max(T.nt, 1) * sizeof(int32_t))
+    if index == NULL:
+        raise MemoryError()
+    try:
+        n = finite_index(T, index)
+        tv_arr = np.empty((n, 3), dtype=np.int32)
+        nb_arr = np.empty((n, 3), dtype=np.int32)
+        if n:
+            finite_into(T, index, _i32v(tv_arr), _i32v(nb_arr))
+    finally:
+        free(index)
+    return tv_arr, nb_arr
+
+
+def background_field(const double[:, ::1] xy, const int64_t[::1] rounds, double[::1] g,
+                     double rate):
+    """The background of a size field without a callable (background.pxi): the
+    Delaunay triangulation of the points xy inserted in BRIO order (rounds: the
+    round keys of _order.brio_order), and, in place, g (one size per point)
+    gradation-limited at `rate` over its edges and inf at the points merged into
+    an equal one.  Returns (tv, nb, finite): the finite triangles as in
+    Triangulation.finite_triangles, and whether g is finite at every used point."""
+    cdef int n = xy.shape[0], i, res = 0, ok, nt
+    cdef int32_t* tv
+    cdef int32_t* merged
+    cdef Tri T
+    if xy.shape[1] != 2 or rounds.shape[0] != n or g.shape[0] != n:
+        raise ValueError("xy, rounds and g must have one row per point")
+    if n < 3:
+        raise ValueError("a background needs at least 3 points")
+    if tri_init(&T, n + 16, 2 * n + 16):
+        raise MemoryError()
+    try:
+        with nogil:
+            for i in range(n):
+                res = add_vertex(&T, xy[i, 0], xy[i, 1])
+                if res < 0:
+                    break
+            if res >= 0:
+                merged = <int32_t*> malloc(n * sizeof(int32_t))
+                res = brio_insert(&T, &xy[0, 0], n, &rounds[0], merged) if merged else ERR_NOMEM
+                free(merged)
+        _raise_for(&T, res)
+        tv_arr, nb_arr = _finite_arrays(&T)
+        nt = len(tv_arr)
+        tv = _i32v(tv_arr)
+        with nogil:
+            res = limit_gradation_tris(n, nt, &xy[0, 0], tv, &g[0], rate, 0.0)
+            ok = unused_to_inf(n, nt, tv, &g[0]) if res == 0 else res
+        if res or ok < 0:
+            raise MemoryError()
+    finally:
+        tri_free(&T)
+    return tv_arr, nb_arr, ok == 1
 
 
 def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t n_rings):
@@ -817,12 +953,14 @@ def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t 
     cdef double[:, ::1] mid = mid_arr, pts = pts_arr
     cdef int64_t[::1] ring = ring_arr, edge = edge_arr, removed = removed_arr
     cdef int64_t[:, ::1] seg = seg_arr
-    if n_open:
+    k = 0
+    if n_open >= NOGIL_MIN_ITEMS:
         with nogil:
             k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
                                  &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
-    else:
-        k = 0
+    elif n_open:
+        k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
+                             &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
     return pts_arr[:k], seg_arr[:k], edge_arr[:k], mid_arr, ring_arr, removed_arr
 
 
@@ -845,6 +983,126 @@ def segment_problems(const int64_t[:, ::1] seg, const double[:, ::1] xy):
                          &xy[0, 0] if xy.shape[0] else NULL)
 
 
+def unique_points(const double[:, ::1] xy):
+    """(first, inverse): the distinct points of xy in lexicographic order, first[j]
+    the index of the first copy of distinct point j, inverse[i] the distinct point of
+    xy[i] (both int64); None when a coordinate is not finite or equal points differ
+    in their bits (0.0 and -0.0).  See unique_points_into in inputs.pxi."""
+    cdef Py_ssize_t n = xy.shape[0], k
+    if xy.shape[1] != 2:
+        raise ValueError("points must have shape (n, 2)")
+    first_arr = np.empty(n, dtype=np.int64)
+    work_arr = np.empty(n, dtype=np.int64)
+    inverse_arr = np.empty(n, dtype=np.int64)
+    cdef int64_t[::1] first = first_arr, work = work_arr, inverse = inverse_arr
+    if n == 0:
+        return first_arr, inverse_arr
+    if n >= NOGIL_MIN_ITEMS:
+        with nogil:
+            k = unique_points_into(&xy[0, 0], n, &first[0], &work[0], &inverse[0])
+    else:
+        k = unique_points_into(&xy[0, 0], n, &first[0], &work[0], &inverse[0])
+    return None if k < 0 else (first_arr[:k], inverse_arr)
+
+
+def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
+    """Whether no vertex lies on the interior of a segment, no segment is repeated and
+    none has equal ends (see rings_are_proper in inputs.pxi; every pair is looked at,
+    so the caller keeps it to small inputs)."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
+    if xy.shape[1] != 2 or seg.shape[1] != 2:
+        raise ValueError("points and segments must have two columns")
+    for k in range(m):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
+            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    if m == 0:
+        return True
+    return rings_are_proper(&xy[0, 0], n, &seg[0, 0], m) == 1
+
+
+def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):
+    """The length of the shortest segment at each point (inf at a point on none)."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
+    if xy.shape[1] != 2 or seg.shape[1] != 2:
+        raise ValueError("points and segments must have two columns")
+    for k in range(m):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
+            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    out_arr = np.empty(n, dtype=np.float64)
+    cdef double[::1] out = out_arr
+    if n:
+        shortest_edges_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0])
+    return out_arr
+
+
+def take_or_none(const int32_t[::1] table, const int32_t[::1] index):
+    """table[index] (int32), -1 where index is -1 (see take_into in inputs.pxi)."""
+    cdef Py_ssize_t m = index.shape[0]
+    out_arr = np.empty(m, dtype=np.int32)
+    if m and take_into(&table[0] if table.shape[0] else NULL, table.shape[0], &index[0], m,
+                       _i32v(out_arr)):
+        raise IndexError("an index is outside -1..len(table) - 1")
+    return out_arr
+
+
+def bounding_box(const double[:, ::1] xy):
+    """((xmin, ymin), (xmax, ymax)) of the points (finite, at least one) as floats."""
+    cdef double box[4]
+    if xy.shape[0] == 0 or xy.shape[1] != 2:
+        raise ValueError("bounding_box needs an (n, 2) array with n > 0")
+    box_of(&xy[0, 0], xy.shape[0], box)
+    return (box[0], box[1]), (box[2], box[3])
+
+
+def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds,
+                    int bits=BRIO_HILBERT_BITS):
+    """The stable argsort (int32) of rounds | hilbert_keys(xy, bits): the BRIO order
+    of _order.brio_order in one call."""
+    cdef Py_ssize_t n = xy.shape[0]
+    if rounds.shape[0] != n:
+        raise ValueError("xy and rounds differ in length")
+    if not 1 <= bits <= 31:
+        raise ValueError(f"bits must be in 1..31, got {bits}")
+    keys_arr = np.empty(n, dtype=np.int64)
+    order_arr = np.empty(n, dtype=np.int64)
+    work_arr = np.empty(n, dtype=np.int64)
+    out_arr = np.empty(n, dtype=np.int32)
+    cdef int64_t[::1] keys = keys_arr, order = order_arr, work = work_arr
+    cdef int32_t[::1] out = out_arr
+    if n == 0:
+        return out_arr
+    if n >= NOGIL_MIN_ITEMS:
+        with nogil:
+            _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
+    else:
+        _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
+    return out_arr
+
+
+cdef void _brio_order(const double* xy, const int64_t* rounds, Py_ssize_t n, int bits,
+                      int64_t* keys, int64_t* order, int64_t* work,
+                      int32_t* out) noexcept nogil:
+    cdef Py_ssize_t i
+    hilbert_keys_into(xy, n, bits, keys)
+    for i in range(n):
+        keys[i] |= rounds[i]
+    stable_order(keys, _key_less, n, order, work)
+    for i in range(n):
+        out[i] = <int32_t> order[i]
+
+
+cdef int _check_discretize(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
+                           int max_samples) except -1:
+    cdef Py_ssize_t i, k
+    if max_samples < DISCRETIZE_MIN_SAMPLES:
+        raise ValueError(f"max_samples must be at least {DISCRETIZE_MIN_SAMPLES}")
+    for i in range(segments.shape[0]):
+        for k in range(2):
+            if not 0 <= segments[i, k] < vertices.shape[0]:
+                raise ValueError(f"segments[{i}] refers to a vertex outside the points")
+    return 0
+
+
 def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
                         const double[::1] g, const int32_t[:, ::1] tv,
                         const int32_t[:, ::1] nb, double rate, double reach,
@@ -855,47 +1113,28 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
     of each point), the points segment by segment, in order along each; or
     (total, None, None) when the pieces would number more than max_pieces."""
     cdef SizeField S
-    cdef Py_ssize_t m = segments.shape[0], i, k, n_pts = 0, at = 0
-    cdef int ns
-    cdef double total = 0.0, c, t
-    cdef const double* a
-    cdef const double* b
-    if max_samples < DISCRETIZE_MIN_SAMPLES:
-        raise ValueError(f"max_samples must be at least {DISCRETIZE_MIN_SAMPLES}")
+    cdef Py_ssize_t m = segments.shape[0], n_pts = 0
+    cdef double total = 0.0
+    _check_discretize(vertices, segments, max_samples)
     _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     cum_arr = np.empty(max_samples, dtype=np.float64)
     pieces_arr = np.empty(m, dtype=np.int64)
     cdef double[::1] cum = cum_arr
     cdef int64_t[::1] pieces = pieces_arr
-    with nogil:
-        for i in range(m):
-            a = &vertices[segments[i, 0], 0]
-            b = &vertices[segments[i, 1], 0]
-            ns = _sample_count(&S, a, b, max_samples)
-            c = rint(_inverse_size_integral(&S, a, b, ns, &cum[0]))
-            pieces[i] = <int64_t> c if c >= 1.0 else 1
-            total += c if c >= 1.0 else 1.0
-            n_pts += pieces[i] - 1
+    if m:
+        with nogil:
+            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                                      &cum[0], &pieces[0], &n_pts)
     if not total <= max_pieces:
         return total, None, None
     pts_arr = np.empty((n_pts, 2), dtype=np.float64)
     row_arr = np.empty(n_pts, dtype=np.int64)
-    cdef double[:, ::1] pts = pts_arr
-    cdef int64_t[::1] row = row_arr
-    with nogil:
-        for i in range(m):
-            if pieces[i] == 1:
-                continue
-            a = &vertices[segments[i, 0], 0]
-            b = &vertices[segments[i, 1], 0]
-            ns = _sample_count(&S, a, b, max_samples)
-            _inverse_size_integral(&S, a, b, ns, &cum[0])
-            for k in range(1, pieces[i]):
-                t = _inverse_interp(cum[ns - 1] * k / pieces[i], &cum[0], ns)
-                pts[at, 0] = a[0] + t * (b[0] - a[0])
-                pts[at, 1] = a[1] + t * (b[1] - a[1])
-                row[at] = i
-                at += 1
+    cdef double* pts = _f64v(pts_arr)
+    cdef int64_t* row = <int64_t*> _f64v(row_arr)
+    if n_pts:
+        with nogil:
+            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                              &cum[0], &pieces[0], pts, row)
     return pieces_arr, pts_arr, row_arr
 
 
@@ -909,65 +1148,54 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     split points (new vertices appended in that order); a split point that rounds
     onto the one before it or onto the segment's end is dropped (a piece of zero
     length would be fatal).  (total, None, None) as discretize_segments."""
-    pieces_arr, pts_arr, _ = discretize_segments(
-        constant, xy, w, g, tv, nb, rate, reach, vertices, segments, max_samples, max_pieces)
-    if pts_arr is None:
-        return pieces_arr, None, None
-    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], i, at = 0, kept = 0
-    cdef Py_ssize_t n_seg, s_at, first
-    cdef int64_t[::1] pieces = pieces_arr
-    cdef double[:, ::1] pts = pts_arr
-    cdef const double* prev
-    keep_arr = np.zeros(len(pts_arr), dtype=np.uint8)
-    cdef uint8_t[::1] keep = keep_arr
-    for i in range(m):
-        if pieces[i] == 1:
-            continue
-        prev = &vertices[segments[i, 0], 0]
-        for _ in range(pieces[i] - 1):
-            if not ((pts[at, 0] == prev[0] and pts[at, 1] == prev[1]) or (
-                    pts[at, 0] == vertices[segments[i, 1], 0]
-                    and pts[at, 1] == vertices[segments[i, 1], 1])):
-                keep[at] = 1
-                kept += 1
-            prev = &pts[at, 0]
-            at += 1
-    n_seg = m + kept        # each split segment: one piece more than its kept points
-    v_out = np.empty((nv + kept, 2), dtype=np.float64)
-    s_out = np.empty((n_seg, 2), dtype=np.int32)
-    e_out = np.empty(n_seg, dtype=np.int32)
-    cdef double[:, ::1] vo = v_out
-    cdef int32_t[:, ::1] so = s_out
-    cdef int32_t[::1] eo = e_out
-    for i in range(nv):
-        vo[i, 0] = vertices[i, 0]
-        vo[i, 1] = vertices[i, 1]
-    s_at = 0
-    for i in range(m):
-        if pieces[i] == 1:
-            so[s_at, 0] = segments[i, 0]
-            so[s_at, 1] = segments[i, 1]
-            eo[s_at] = source[i]
-            s_at += 1
-    at = 0
-    kept = 0
-    for i in range(m):
-        if pieces[i] == 1:
-            continue
-        first = segments[i, 0]
-        for _ in range(pieces[i] - 1):
-            if keep[at]:
-                vo[nv + kept, 0] = pts[at, 0]
-                vo[nv + kept, 1] = pts[at, 1]
-                so[s_at, 0] = first
-                so[s_at, 1] = nv + kept
-                eo[s_at] = source[i]
-                first = nv + kept
-                s_at += 1
-                kept += 1
-            at += 1
-        so[s_at, 0] = first
-        so[s_at, 1] = segments[i, 1]
-        eo[s_at] = source[i]
-        s_at += 1
+    cdef SizeField S
+    cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], n_pts = 0, kept = 0
+    cdef double total = 0.0
+    cdef double* pts
+    cdef uint8_t* keep
+    cdef bint release
+    _check_discretize(vertices, segments, max_samples)
+    if source.shape[0] != m:
+        raise ValueError("segments and source differ in length")
+    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
+    cdef double* cum = <double*> malloc(max_samples * sizeof(double))
+    cdef int64_t* pieces = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
+    try:
+        if cum == NULL or pieces == NULL:
+            raise MemoryError()
+        # a background makes every sample a walk; with a constant, small inputs are
+        # a few microseconds (see NOGIL_MIN_ITEMS)
+        release = S.nt > 0 or m >= NOGIL_MIN_ITEMS
+        if release and m:
+            with nogil:
+                total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
+                                          max_samples, cum, pieces, &n_pts)
+        elif m:
+            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
+                                      max_samples, cum, pieces, &n_pts)
+        if not total <= max_pieces:
+            return total, None, None
+        pts_arr = np.empty((n_pts, 2), dtype=np.float64)
+        keep_arr = np.empty(n_pts, dtype=np.uint8)
+        pts = _f64v(pts_arr)
+        keep = _u8v(keep_arr)
+        if n_pts and release:
+            with nogil:
+                discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                                  cum, pieces, pts, NULL)
+                kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
+        elif n_pts:
+            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                              cum, pieces, pts, NULL)
+            kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
+        # each split segment: one piece more than its kept points
+        v_out = np.empty((nv + kept, 2), dtype=np.float64)
+        s_out = np.empty((m + kept, 2), dtype=np.int32)
+        e_out = np.empty(m + kept, dtype=np.int32)
+        if m:
+            chain_write(&vertices[0, 0], nv, &segments[0, 0], &source[0], m, pieces, pts,
+                        keep, _f64v(v_out), _i32v(s_out), _i32v(e_out))
+    finally:
+        free(cum)
+        free(pieces)
     return v_out, s_out, e_out

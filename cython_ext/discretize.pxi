@@ -93,3 +93,113 @@ cdef double _inverse_interp(double x, const double* cum, int ns) noexcept nogil:
         if isnan(val) and sj == sj1:
             val = sj
     return val
+
+
+cdef double discretize_counts(SizeField* S, const double* v, const int32_t* seg,
+                              Py_ssize_t m, int max_samples, double* cum,
+                              int64_t* pieces, Py_ssize_t* n_pts) noexcept nogil:
+    """pieces[i] = the number of pieces of segment i (seg[2i] -> seg[2i+1] on the
+    points v) by the size (at least 1); n_pts = the split points in all.  Returns
+    the total number of pieces (a float: it may exceed any integer type)."""
+    cdef Py_ssize_t i
+    cdef int ns
+    cdef double total = 0.0, c
+    cdef const double* a
+    cdef const double* b
+    n_pts[0] = 0
+    for i in range(m):
+        a = &v[2 * seg[2 * i]]
+        b = &v[2 * seg[2 * i + 1]]
+        ns = _sample_count(S, a, b, max_samples)
+        c = rint(_inverse_size_integral(S, a, b, ns, cum))
+        pieces[i] = <int64_t> c if c >= 1.0 else 1
+        total += c if c >= 1.0 else 1.0
+        n_pts[0] += pieces[i] - 1
+    return total
+
+
+cdef void discretize_points(SizeField* S, const double* v, const int32_t* seg,
+                            Py_ssize_t m, int max_samples, double* cum,
+                            const int64_t* pieces, double* pts, int64_t* row) noexcept nogil:
+    """The split points of each segment with pieces[i] > 1, segment by segment and in
+    order along each, into pts (and the segment of each into row, unless NULL)."""
+    cdef Py_ssize_t i, k, at = 0
+    cdef int ns
+    cdef double t
+    cdef const double* a
+    cdef const double* b
+    for i in range(m):
+        if pieces[i] == 1:
+            continue
+        a = &v[2 * seg[2 * i]]
+        b = &v[2 * seg[2 * i + 1]]
+        ns = _sample_count(S, a, b, max_samples)
+        _inverse_size_integral(S, a, b, ns, cum)
+        for k in range(1, pieces[i]):
+            t = _inverse_interp(cum[ns - 1] * k / pieces[i], cum, ns)
+            pts[2 * at] = a[0] + t * (b[0] - a[0])
+            pts[2 * at + 1] = a[1] + t * (b[1] - a[1])
+            if row != NULL:
+                row[at] = i
+            at += 1
+
+
+cdef Py_ssize_t chain_keep(const double* v, const int32_t* seg, Py_ssize_t m,
+                           const int64_t* pieces, const double* pts,
+                           uint8_t* keep) noexcept nogil:
+    """keep[j] = 1 for the split points that differ from the point before them on
+    their segment and from the segment's end (a piece of zero length would be
+    fatal); returns how many are kept."""
+    cdef Py_ssize_t i, j, at = 0, kept = 0
+    cdef const double* prev
+    cdef const double* end
+    for i in range(m):
+        if pieces[i] == 1:
+            continue
+        prev = &v[2 * seg[2 * i]]
+        end = &v[2 * seg[2 * i + 1]]
+        for j in range(pieces[i] - 1):
+            keep[at] = not ((pts[2 * at] == prev[0] and pts[2 * at + 1] == prev[1])
+                            or (pts[2 * at] == end[0] and pts[2 * at + 1] == end[1]))
+            kept += keep[at]
+            prev = &pts[2 * at]
+            at += 1
+    return kept
+
+
+cdef void chain_write(const double* v, Py_ssize_t nv, const int32_t* seg,
+                      const int32_t* source, Py_ssize_t m, const int64_t* pieces,
+                      const double* pts, const uint8_t* keep, double* vo, int32_t* so,
+                      int32_t* eo) noexcept nogil:
+    """The new PSLG: vo = the points v then the kept split points; so / eo = the
+    unsplit segments first, then each split segment as the chain through its kept
+    split points, each piece with its segment's source."""
+    cdef Py_ssize_t i, j, at = 0, kept = 0, s_at = 0
+    cdef int32_t first
+    for i in range(2 * nv):
+        vo[i] = v[i]
+    for i in range(m):
+        if pieces[i] == 1:
+            so[2 * s_at] = seg[2 * i]
+            so[2 * s_at + 1] = seg[2 * i + 1]
+            eo[s_at] = source[i]
+            s_at += 1
+    for i in range(m):
+        if pieces[i] == 1:
+            continue
+        first = seg[2 * i]
+        for j in range(pieces[i] - 1):
+            if keep[at]:
+                vo[2 * (nv + kept)] = pts[2 * at]
+                vo[2 * (nv + kept) + 1] = pts[2 * at + 1]
+                so[2 * s_at] = first
+                so[2 * s_at + 1] = <int32_t> (nv + kept)
+                eo[s_at] = source[i]
+                first = <int32_t> (nv + kept)
+                s_at += 1
+                kept += 1
+            at += 1
+        so[2 * s_at] = first
+        so[2 * s_at + 1] = seg[2 * i + 1]
+        eo[s_at] = source[i]
+        s_at += 1

@@ -1,10 +1,12 @@
 # Per-call input work on small arrays, where numpy's cost per call would exceed the
-# work itself: ring clean-up and the checks of coordinates and segment indices
-# (src/aftmesh/inputs.py, pslg.py).  The Python side words the errors.
+# work itself: ring clean-up, the checks of coordinates and segment indices, the
+# distinct points of a vertex list and the proper-rings test of noding.py, the
+# shortest input edge at each vertex, a stable argsort (src/aftmesh/inputs.py,
+# noding.py, pslg.py, _order.py, _stages.py).  The Python side words the errors.
 #
-# Uses: libc only; no triangulation, no predicates.
-from libc.math cimport fabs, isfinite
-from libc.stdint cimport int64_t
+# Uses: libc, and orient2d from predicates.pxi (rings_are_proper); no triangulation.
+from libc.math cimport INFINITY, fabs, isfinite, sqrt
+from libc.stdint cimport int32_t, int64_t, uint64_t
 
 # Bits of coordinate_flags / segment_flags.
 cdef enum:
@@ -88,3 +90,179 @@ cdef int segment_flags(const int64_t* seg, Py_ssize_t m, Py_ssize_t n,
         elif a == b or (xy[2 * a] == xy[2 * b] and xy[2 * a + 1] == xy[2 * b + 1]):
             flags |= SEG_ZERO_LENGTH
     return flags
+
+
+# ------------------------------------------------------------------ sorting
+# A stable merge sort of indices 0..n-1 by a "less" rule on them: the same order as
+# numpy's stable argsort / lexsort, without numpy's cost per call on small inputs.
+
+ctypedef bint (*index_less)(const void* data, Py_ssize_t i, Py_ssize_t j) noexcept nogil
+
+
+cdef bint _xy_less(const void* data, Py_ssize_t i, Py_ssize_t j) noexcept nogil:
+    """Point i before point j lexicographically (x, then y), as np.lexsort((y, x))."""
+    cdef const double* xy = <const double*> data
+    if xy[2 * i] != xy[2 * j]:
+        return xy[2 * i] < xy[2 * j]
+    return xy[2 * i + 1] < xy[2 * j + 1]
+
+
+cdef bint _key_less(const void* data, Py_ssize_t i, Py_ssize_t j) noexcept nogil:
+    cdef const int64_t* key = <const int64_t*> data
+    return key[i] < key[j]
+
+
+cdef void stable_order(const void* data, index_less less, Py_ssize_t n,
+                       int64_t* order, int64_t* work) noexcept nogil:
+    """order = the indices 0..n-1 sorted stably by `less` (bottom-up merge sort;
+    `work` holds n scratch entries)."""
+    cdef Py_ssize_t i, width = 1, lo, mid, hi, a, b, k
+    cdef int64_t* src = order
+    cdef int64_t* dst = work
+    cdef int64_t* tmp
+    for i in range(n):
+        order[i] = i
+    while width < n:
+        lo = 0
+        while lo < n:
+            mid = min(lo + width, n)
+            hi = min(lo + 2 * width, n)
+            a, b, k = lo, mid, lo
+            while a < mid and b < hi:
+                # the right run's entry goes first only if strictly less: stable
+                if less(data, src[b], src[a]):
+                    dst[k] = src[b]
+                    b += 1
+                else:
+                    dst[k] = src[a]
+                    a += 1
+                k += 1
+            while a < mid:
+                dst[k] = src[a]
+                a += 1
+                k += 1
+            while b < hi:
+                dst[k] = src[b]
+                b += 1
+                k += 1
+            lo = hi
+        tmp = src
+        src = dst
+        dst = tmp
+        width *= 2
+    if src != order:
+        for i in range(n):
+            order[i] = src[i]
+
+
+cdef Py_ssize_t unique_points_into(const double* xy, Py_ssize_t n, int64_t* order,
+                                   int64_t* work, int64_t* inverse) noexcept nogil:
+    """The distinct points of xy in lexicographic order, as noding.unique_rows
+    defines them: order[0..k) the first index of each run of equal points in the
+    stable lexicographic order (k is returned), inverse[i] the run of point i.
+    Returns -1 when a coordinate is not finite or two equal points differ in their
+    bits (0.0 and -0.0): numpy's np.unique then decides."""
+    cdef Py_ssize_t i, k = 0
+    cdef int64_t p, q = 0
+    cdef const uint64_t* bits = <const uint64_t*> xy
+    for i in range(2 * n):
+        if not isfinite(xy[i]):
+            return -1
+    stable_order(xy, _xy_less, n, order, work)
+    for i in range(n):
+        p = order[i]
+        if i and xy[2 * p] == xy[2 * q] and xy[2 * p + 1] == xy[2 * q + 1]:
+            if bits[2 * p] != bits[2 * q] or bits[2 * p + 1] != bits[2 * q + 1]:
+                return -1
+        else:
+            order[k] = p
+            k += 1
+            q = p
+        inverse[p] = k - 1
+    return k
+
+
+cdef int rings_are_proper(const double* xy, Py_ssize_t n, const int64_t* seg,
+                          Py_ssize_t m) noexcept nogil:
+    """1 when no vertex lies on the interior of a segment (exactly, by orient2d, and
+    strictly between its ends by the dot products noding.split_at_vertices uses), no
+    segment is given twice (either way round) and none joins a vertex to itself;
+    0 otherwise.  Looks at every (vertex, segment) and (segment, segment) pair: for
+    small inputs only."""
+    cdef Py_ssize_t v, k, j
+    cdef int64_t a, b
+    cdef const double* pa
+    cdef const double* pb
+    cdef const double* pv
+    for k in range(m):
+        a = seg[2 * k]
+        b = seg[2 * k + 1]
+        if a == b:
+            return 0
+        for j in range(k + 1, m):
+            if (seg[2 * j] == a and seg[2 * j + 1] == b) or (
+                    seg[2 * j] == b and seg[2 * j + 1] == a):
+                return 0
+        pa = &xy[2 * a]
+        pb = &xy[2 * b]
+        for v in range(n):
+            if v == a or v == b:
+                continue
+            pv = &xy[2 * v]
+            if (pv[0] < min(pa[0], pb[0]) or pv[0] > max(pa[0], pb[0])
+                    or pv[1] < min(pa[1], pb[1]) or pv[1] > max(pa[1], pb[1])):
+                continue  # outside the segment's box: not on it
+            if orient2d(pa, pb, pv) != 0:
+                continue
+            if ((pv[0] - pa[0]) * (pb[0] - pa[0]) + (pv[1] - pa[1]) * (pb[1] - pa[1]) > 0
+                    and (pv[0] - pb[0]) * (pa[0] - pb[0])
+                    + (pv[1] - pb[1]) * (pa[1] - pb[1]) > 0):
+                return 0
+    return 1
+
+
+cdef void shortest_edges_into(const double* xy, Py_ssize_t n, const int32_t* seg,
+                              Py_ssize_t m, double* out) noexcept nogil:
+    """out[v] = the length of the shortest segment at vertex v, inf if none."""
+    cdef Py_ssize_t k, v
+    cdef int32_t a, b
+    cdef double d
+    for v in range(n):
+        out[v] = INFINITY
+    for k in range(m):
+        a = seg[2 * k]
+        b = seg[2 * k + 1]
+        # as np.linalg.norm(..., axis=1) rounds it (hypot may differ by an ulp)
+        d = sqrt((xy[2 * b] - xy[2 * a]) * (xy[2 * b] - xy[2 * a])
+                 + (xy[2 * b + 1] - xy[2 * a + 1]) * (xy[2 * b + 1] - xy[2 * a + 1]))
+        if d < out[a]:
+            out[a] = d
+        if d < out[b]:
+            out[b] = d
+
+
+cdef int take_into(const int32_t* table, Py_ssize_t n, const int32_t* index, Py_ssize_t m,
+                   int32_t* out) noexcept nogil:
+    """out[i] = table[index[i]], -1 where index[i] is -1 (the kernel's and the domain's
+    "none"); returns -1 if an index is outside -1..n-1 (nothing is read there), else 0."""
+    cdef Py_ssize_t i
+    for i in range(m):
+        if index[i] == -1:
+            out[i] = -1
+        elif 0 <= index[i] < n:
+            out[i] = table[index[i]]
+        else:
+            return -1
+    return 0
+
+
+cdef void box_of(const double* xy, Py_ssize_t n, double* box) noexcept nogil:
+    """box = (xmin, ymin, xmax, ymax) of the n points (n > 0, finite)."""
+    cdef Py_ssize_t i
+    box[0] = box[2] = xy[0]
+    box[1] = box[3] = xy[1]
+    for i in range(1, n):
+        box[0] = min(box[0], xy[2 * i])
+        box[1] = min(box[1], xy[2 * i + 1])
+        box[2] = max(box[2], xy[2 * i])
+        box[3] = max(box[3], xy[2 * i + 1])

@@ -116,3 +116,169 @@ def test_drop_repeats_keeps_the_first_copy_of_each_segment(pairs):
 @pytest.mark.parametrize("n", [1, 7, _order.CACHED_ROUNDS, _order.CACHED_ROUNDS + 1])
 def test_cached_brio_round_keys_are_the_drawn_ones(n):
     assert (_order._round_keys(n, _order.SEED) == _order._draw_round_keys(n, _order.SEED)).all()
+
+
+@given(st.lists(st.tuples(coordinate, coordinate), max_size=12))
+def test_unique_points_gives_the_first_copy_of_each_distinct_point(rows):
+    pts = np.array(rows, dtype=np.float64).reshape(-1, 2)
+    found = _kernel.unique_points(pts)
+    order = np.lexsort((pts[:, 1], pts[:, 0]))
+    srt = pts[order]
+    start = np.ones(len(pts), dtype=bool)
+    start[1:] = (srt[1:] != srt[:-1]).any(axis=1)
+    bits = srt.view(np.int64)
+    if not (bits[1:][~start[1:]] == bits[:-1][~start[1:]]).all():
+        assert found is None  # 0.0 and -0.0: left to np.unique
+        return
+    first, inverse = found
+    assert (first == order[start]).all()
+    assert (inverse[order] == np.cumsum(start) - 1).all()
+
+
+def test_unique_points_leaves_non_finite_points_to_numpy():
+    assert _kernel.unique_points(np.array([[0.0, 1.0], [np.nan, 0.0]])) is None
+
+
+# Vertices of a square ring and of a second ring touching it, for rings_proper.
+SQUARE = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)]
+
+
+@pytest.mark.parametrize(
+    "extra, proper",
+    [
+        ([(0.5, 0.5), (1.5, 0.5), (1.0, 1.5)], True),  # a hole inside
+        ([(1.0, 0.0), (1.5, 0.5), (0.5, 0.5)], False),  # a hole corner on an edge
+        ([(2.0, 2.0), (1.5, 1.0), (1.0, 1.5)], True),  # touching at a shared corner
+        ([(3.0, 0.0), (4.0, 0.0), (3.5, 1.0)], True),  # on the edge's line, beyond it
+    ],
+)
+def test_rings_proper_agrees_with_the_split_at_vertices(extra, proper):
+    from aftmesh.noding import split_at_vertices
+
+    pts = np.array(SQUARE + extra, dtype=np.float64)
+    first, inverse = _kernel.unique_points(pts)
+    uniq = pts[first]
+    ring = np.array([[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 4]])
+    segs = inverse[ring]
+    src = np.arange(len(segs))
+    split, _ = split_at_vertices(uniq, segs, src, None, 0.0, np.ones(len(src), dtype=bool))
+    assert (len(split) == len(segs)) == proper
+    assert _kernel.rings_proper(uniq, np.ascontiguousarray(segs, dtype=np.int64)) == proper
+
+
+@given(st.lists(st.tuples(st.integers(0, 4), st.integers(0, 4)), max_size=8))
+def test_rings_proper_refuses_repeated_and_zero_length_segments(pairs):
+    xy = np.array([[0, 0], [4, 1], [3, 5], [-1, 3], [1, 2.5]], dtype=np.float64)
+    segs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+    got, _ = _drop_repeats(segs, np.arange(len(segs)))
+    on_interior = False  # no vertex of these five is on a segment between two others
+    want = len(got) == len(segs) and not on_interior
+    assert _kernel.rings_proper(xy, segs) == want
+
+
+@given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5)), max_size=10))
+def test_shortest_edges_is_the_numpy_minimum(pairs):
+    rng = np.random.default_rng(len(pairs))
+    xy = rng.normal(size=(6, 2))
+    seg = np.array(pairs, dtype=np.int32).reshape(-1, 2)
+    lengths = np.linalg.norm(xy[seg[:, 1]] - xy[seg[:, 0]], axis=1)
+    want = np.full(len(xy), np.inf)
+    np.minimum.at(want, seg[:, 0], lengths)
+    np.minimum.at(want, seg[:, 1], lengths)
+    assert _kernel.shortest_edges(xy, seg).tobytes() == want.tobytes()
+
+
+@pytest.mark.parametrize("n", [0, 1, 2, 9, 200, 5000])
+def test_brio_keys_order_is_the_stable_numpy_argsort(n):
+    rng = np.random.default_rng(n)
+    # a coarse grid: many points share a Hilbert cell, so the sort's ties matter
+    xy = np.ascontiguousarray(rng.integers(0, 4, size=(n, 2)).astype(np.float64))
+    rounds = _order._draw_round_keys(n, _order.SEED)
+    keys = rounds | _kernel.hilbert_keys(xy)
+    want = np.argsort(keys, kind="stable").astype(np.int32)
+    assert (_kernel.brio_keys_order(xy, rounds) == want).all()
+
+
+@pytest.mark.parametrize("n", [3, 10, 300])
+def test_background_field_is_the_triangulation_and_gradation_it_replaces(n):
+    rng = np.random.default_rng(n)
+    xy = rng.integers(0, 12, size=(n, 2)).astype(np.float64)  # repeats: merged points
+    xy[:3] = [[-1.0, -1.0], [13.0, -1.0], [6.0, 13.0]]  # never all collinear
+    g = rng.uniform(0.1, 2.0, n)
+    g[rng.integers(0, n, n // 3)] = np.inf
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(_order.brio_order(xy))
+    want_tv, want_nb = tri.finite_triangles()
+    want_g = g.copy()
+    _kernel.limit_gradation_mesh(xy, want_tv, want_g, 0.3)
+    used = np.zeros(n, dtype=bool)
+    used[want_tv.ravel()] = True
+    want_g[~used] = np.inf
+    got_g = g.copy()
+    tv, nb, finite = _kernel.background_field(xy, _order.round_keys(n), got_g, 0.3)
+    assert (tv == want_tv).all() and (nb == want_nb).all()
+    assert got_g.tobytes() == want_g.tobytes()
+    assert finite == bool(np.isfinite(want_g[used]).all())
+
+
+def _pslg_by_steps(xy, seg, from_hull):
+    tri = _kernel.Triangulation(xy)
+    merged = tri.insert_points(_order.brio_order(xy))
+    split = tri.insert_segments(np.ascontiguousarray(merged[seg], dtype=np.int32))
+    tri.carve(np.zeros((0, 2)), from_hull)
+    return tri, merged, split
+
+
+@pytest.mark.parametrize("from_hull", [True, False])
+@pytest.mark.parametrize("n", [4, 40, 400])
+def test_insert_pslg_is_the_insertions_and_carve_it_replaces(n, from_hull):
+    rng = np.random.default_rng(n)
+    ring = np.c_[np.cos(np.linspace(0, 2 * np.pi, n, endpoint=False)), np.zeros(n)]
+    ring[:, 1] = np.sin(np.linspace(0, 2 * np.pi, n, endpoint=False))
+    inner = rng.uniform(-0.5, 0.5, size=(n, 2)).round(1)  # repeats: merged points
+    xy = np.ascontiguousarray(np.r_[ring, inner, ring[:1]])  # and a repeated corner
+    seg = np.c_[np.arange(n), (np.arange(n) + 1) % n].astype(np.int32)
+    seg = np.r_[seg, [[n, n + 1], [2 * n, 1]]].astype(np.int32)  # one ends at the copy
+    want, want_merged, want_split = _pslg_by_steps(xy, seg, from_hull)
+    got = _kernel.Triangulation(xy)
+    merged, n_merged, split = got.insert_pslg(_order.round_keys(len(xy)), seg, from_hull)
+    assert (merged == want_merged).all() and split == want_split
+    assert n_merged == int((want_merged != np.arange(len(xy))).sum()) > 0
+    for name, value in want.raw().items():
+        assert (got.raw()[name] == value).all(), name
+
+
+def test_insert_pslg_names_the_crossing_segment():
+    xy = np.array([[0, 0], [2, 0], [2, 2], [0, 2]], dtype=np.float64)
+    seg = np.array([[0, 2], [1, 3]], dtype=np.int32)
+    with pytest.raises(_kernel.CrossingError) as info:
+        _kernel.Triangulation(xy).insert_pslg(_order.round_keys(4), seg, True)
+    assert info.value.index == 1 and info.value.blocker_segment == 0
+
+
+@given(st.lists(st.integers(-1, 4), max_size=10))
+def test_take_or_none_is_the_lookup_with_minus_one_for_none(index):
+    table = np.array([7, -1, 3, 0, 9], dtype=np.int32)
+    idx = np.array(index, dtype=np.int32)
+    want = np.where(idx < 0, -1, table[np.maximum(idx, 0)])
+    assert (_kernel.take_or_none(table, idx) == want).all()
+
+
+def test_take_or_none_refuses_an_index_outside_the_table():
+    with pytest.raises(IndexError):
+        _kernel.take_or_none(np.zeros(3, dtype=np.int32), np.array([0, 3], dtype=np.int32))
+
+
+@given(st.lists(st.tuples(coordinate, coordinate), min_size=1, max_size=12))
+def test_bounding_box_is_the_numpy_minimum_and_maximum(rows):
+    xy = np.array(rows, dtype=np.float64)
+    lo, hi = _kernel.bounding_box(xy)
+    assert lo == tuple(xy.min(axis=0)) and hi == tuple(xy.max(axis=0))
+
+
+def test_unique_points_of_many_points_is_numpy_unique():
+    # above the kernel's NOGIL_MIN_ITEMS: the same routine without the GIL
+    pts = np.random.default_rng(7).integers(0, 40, size=(5000, 2)).astype(np.float64)
+    want, want_inverse = np.unique(pts, axis=0, return_inverse=True)
+    got, inverse = unique_rows(pts)
+    assert got.tobytes() == want.tobytes() and (inverse == want_inverse.reshape(-1)).all()

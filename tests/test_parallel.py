@@ -168,3 +168,21 @@ def test_sizes_not_matching_the_domains_are_refused_naming_both_lengths():
 def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(aftmesh.InvalidOptionError, match=message):
         aftmesh.generate_many([box(0, 0, 1, 1)], 0.5, **options)
+
+
+def test_threads_hand_over_results_in_batches_without_losing_or_hiding_any(checked):
+    # more domains than one batch of results (parallel.RESULTS_PER_WAKE), one failing
+    from aftmesh.parallel import RESULTS_PER_WAKE
+
+    n = 2 * RESULTS_PER_WAKE + 5
+    bad = RESULTS_PER_WAKE + 3
+    domains = [box(i, 0, i + 1, 1) for i in range(n)]
+    domains[bad] = BOWTIE
+    out = aftmesh.generate_many(domains, 0.5, workers=2, errors="collect")
+    assert [isinstance(m, MeshingFailure) for m in out] == [i == bad for i in range(n)]
+    for i, mesh in enumerate(out):
+        if i != bad:
+            assert checked(mesh).area() == pytest.approx(1.0, rel=1e-12)
+    with pytest.raises(aftmesh.InvalidDomainError, match=f"domain {bad}: ") as info:
+        aftmesh.generate_many(domains, 0.5, workers=2)
+    assert info.value.index == bad

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._kernel import hilbert_keys
+from ._kernel import brio_keys_order
 
 # The default seed of the random rounds.
 SEED = 20231121
@@ -19,6 +19,12 @@ SEED = 20231121
 # call: drawing them costs more than the rest of ordering a small input.
 CACHED_ROUNDS = 4096
 _cached_rounds: np.ndarray | None = None
+
+
+def round_keys(n: int, seed: int = SEED) -> np.ndarray:
+    """The BRIO round keys of n points (the high bits of brio_order's keys), for the
+    kernel's own BRIO insertions (background_field)."""
+    return _round_keys(n, seed)
 
 
 def _round_keys(n: int, seed: int) -> np.ndarray:
@@ -49,5 +55,5 @@ def brio_order(xy: np.ndarray, seed: int = SEED) -> np.ndarray:
     n = len(xy)
     if n == 0:
         return np.zeros(0, dtype=np.int32)
-    keys = _round_keys(n, seed) | hilbert_keys(np.ascontiguousarray(xy, dtype=np.float64))
-    return np.argsort(keys, kind="stable").astype(np.int32)
+    # the Hilbert keys and their stable sort in one compiled call
+    return brio_keys_order(np.ascontiguousarray(xy, dtype=np.float64), _round_keys(n, seed))

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._kernel import size_field_count
+from ._kernel import bounding_box, shortest_edges, size_field_count, take_or_none
 from .aft import basic_aft
 from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
@@ -72,7 +72,8 @@ def _progress_callback(progress, expected_triangles: int):
     if callable(progress):
         return progress
     if progress is None:
-        progress = sys.stderr.isatty() and expected_triangles > PROGRESS_MIN_TRIANGLES
+        # the size first: isatty is a system call, and most meshes are small
+        progress = expected_triangles > PROGRESS_MIN_TRIANGLES and sys.stderr.isatty()
     return _ProgressBar(sys.stderr) if progress else None
 
 
@@ -80,11 +81,10 @@ def expected_triangles(field: SizeField, area: float, gradation: float) -> float
     """About how many triangles the size field asks for on `area`: the integral of
     1 / (equilateral area of h) over the background's triangles, scaled to the
     domain's share of them (the kernel's size_field_count says how it counts)."""
+    if field.is_constant:
+        h = float(field.constant)  # > 0; Python floats overflow to inf as numpy's do
+        return float(area) / (EQUILATERAL_AREA * h) / h
     with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
-        if field.is_constant:
-            return float(
-                np.float64(area) / (EQUILATERAL_AREA * np.float64(field.h_min)) / field.h_min
-            )
         total, covered = size_field_count(*field.kernel_args(), MIN_ESTIMATE_RATE, EQUILATERAL_AREA)
         return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
 
@@ -96,23 +96,22 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
     never asks for more than that edge there."""
     if isinstance(size, np.ndarray) and size.ndim == 0:
         size = size.item()
-    lo = dom.vertices.min(axis=0)
-    hi = dom.vertices.max(axis=0)
+    lo, hi = bounding_box(np.ascontiguousarray(dom.vertices, dtype=np.float64))
     if isinstance(size, (list, tuple, np.ndarray)):
         if dom.polygons is None:
             raise InvalidSizeError("a list of sizes needs a list of region polygons as the domain")
         size = per_region_size(dom.polygons, size)
     seg = dom.segments
     if len(seg):
-        lengths = np.linalg.norm(dom.vertices[seg[:, 1]] - dom.vertices[seg[:, 0]], axis=1)
-        shortest = np.full(len(dom.vertices), np.inf)
-        np.minimum.at(shortest, seg[:, 0], lengths)
-        np.minimum.at(shortest, seg[:, 1], lengths)
+        verts = np.ascontiguousarray(dom.vertices, dtype=np.float64)
+        shortest = shortest_edges(verts, np.ascontiguousarray(seg, dtype=np.int32))
         used = np.isfinite(shortest)
-        field = make_size_field(size, (lo, hi), dom.vertices[used], shortest[used], gradation)
+        if not used.all():  # a lone point: no edge there
+            verts, shortest = verts[used], shortest[used]
+        field = make_size_field(size, (lo, hi), verts, shortest, gradation)
     else:
         field = make_size_field(size, (lo, hi), gradation=gradation)
-    area = dom.area if dom.area else float(np.prod(np.maximum(hi - lo, 1e-300)))
+    area = dom.area or max(hi[0] - lo[0], 1e-300) * max(hi[1] - lo[1], 1e-300)
     expected = expected_triangles(field, area, gradation)
     if not expected <= MAX_TRIANGLES:
         raise InvalidSizeError(
@@ -201,7 +200,9 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
     """Give the CDT's pieces their regions, check the domain has area and fits
     max_triangles, and hand the size field and options to the kernel."""
     kernel = boundary.built.kernel
-    if dom.polygons is not None:
+    # one polygon whose one ring is the only source: the carve left one piece, in
+    # region 0 already (every triangle starts there)
+    if dom.polygons is not None and not (len(dom.polygons) == 1 and len(dom.source_names) == 1):
         comp, probes, corners = kernel.components()
         kernel.set_regions(comp, classify_pieces(dom.polygons, probes, corners))
     _, n_unmeshed, _ = kernel.state_counts()
@@ -268,10 +269,9 @@ def refine(kernel, dom: Domain, opts: Options) -> dict | None:
 def _lookup(table: np.ndarray, index: np.ndarray) -> np.ndarray:
     """table[index] as int32, -1 where index is -1 (the kernel's and the domain's
     "none"; no index is below that)."""
-    out = np.empty(len(table) + 1, dtype=np.int32)
-    out[:-1] = table
-    out[-1] = -1
-    return out[index]
+    return take_or_none(
+        np.ascontiguousarray(table, dtype=np.int32), np.ascontiguousarray(index, dtype=np.int32)
+    )
 
 
 def assemble(

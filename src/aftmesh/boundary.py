@@ -43,8 +43,6 @@ def discretize(
     size asks for."""
     if len(segments) == 0:
         return vertices, segments, source
-    a = vertices[segments[:, 0]]
-    b = vertices[segments[:, 1]]
     if not clear > 0:
         out = discretize_boundary(
             *field.kernel_args(),
@@ -66,6 +64,8 @@ def discretize(
     )
     if pts is None:
         _refuse(pieces, limit)
+    a = vertices[segments[:, 0]]
+    b = vertices[segments[:, 1]]
     split = np.flatnonzero(pieces > 1)
     counts = pieces[split] - 1  # split points of each split segment
     if clear > 0 and len(split):

@@ -42,9 +42,12 @@ __all__ = ["Domain", "to_domain"]
 # Two regions overlap when their common area exceeds this fraction of the smaller
 # one: below it the overlap is the rounding of a shared boundary, not a real overlap.
 REGION_OVERLAP = 1e-12
+# Up to this many polygons, their rings are taken one polygon at a time: shapely's
+# vectorized get_rings costs about 10 us however few there are.
+FEW_POLYGONS = 16
 
 
-def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
+def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str], coords=None):
     """Every ring of the polygons at once (each polygon's exterior ring, then its
     holes): its distinct vertices in order, each with its outgoing input edge.  A run
     of repeated vertices is kept once, as its last copy, whose outgoing edge is the
@@ -56,17 +59,42 @@ def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str]):
     vertices.  Returns (vertices, segments, input edge of each segment, ring of each
     input edge, midpoint of each input edge, ring names); a ring of n vertices
     (closing one not counted) has n input edges, numbered on from the ring before."""
-    holes = shapely.get_num_interior_rings(polygons)
-    # get_rings is several times slower than taking the exterior rings when that is all
-    rings = shapely.get_rings(polygons) if holes.any() else shapely.get_exterior_ring(polygons)
-    coords, ring_of = shapely.get_coordinates(rings, return_index=True)
+    if (
+        coords is not None
+        and len(polygons) == 1
+        and not shapely.get_num_interior_rings(polygons[0])
+    ):
+        # a lone polygon without holes: its coordinates are its one ring's
+        ring_of, holes = np.zeros(len(coords), dtype=np.int64), [0]
+    else:
+        rings, holes = _rings(polygons)
+        coords, ring_of = shapely.get_coordinates(rings, return_index=True)
     pts, segs, edge, mid, ring, removed = ring_chains(
-        coords, ring_of.astype(np.int64, copy=False), len(rings)
+        coords, ring_of.astype(np.int64, copy=False), len(holes) + sum(holes)
     )
-    ring_names = _ring_names(names, holes.tolist())
-    for r in np.flatnonzero(removed).tolist():
-        note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
+    ring_names = _ring_names(names, holes)
+    if removed.any():
+        for r in np.flatnonzero(removed).tolist():
+            note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
     return pts, segs, edge, ring, mid, ring_names
+
+
+def _rings(polygons: list[Polygon]) -> tuple[list | np.ndarray, list[int]]:
+    """Each polygon's exterior ring then its holes, and the number of holes of each."""
+    if len(polygons) <= FEW_POLYGONS:
+        rings: list = []
+        holes = []
+        for p in polygons:
+            inner = list(p.interiors)
+            rings.append(p.exterior)
+            rings.extend(inner)
+            holes.append(len(inner))
+        return rings, holes
+    n_holes = shapely.get_num_interior_rings(polygons)
+    # get_rings is several times slower than taking the exterior rings when that is all
+    if n_holes.any():
+        return shapely.get_rings(polygons), n_holes.tolist()
+    return shapely.get_exterior_ring(polygons), n_holes.tolist()
 
 
 def _ring_names(names: list[str], holes: list[int]) -> list[str]:
@@ -121,12 +149,14 @@ def _from_shapely(
     tolerance: float = 0.0,
     valid: bool = False,
     area: float | None = None,
+    coords: np.ndarray | None = None,
 ) -> Domain:
     """Rings of the polygons, constraint lines and fixed points -> a noded Domain.
     `valid`: the polygons are known valid, one polygon or the parts of a valid
-    multipolygon (so their rings cannot cross); `area`: the area of their union."""
+    multipolygon (so their rings cannot cross); `area`: the area of their union;
+    `coords`: the coordinates of a lone polygon, if check_polygon has them."""
     note: list[str] = []
-    rings = _ring_arrays(polygons, names, note)
+    rings = _ring_arrays(polygons, names, note, coords)
     n_rings = len(rings[5])
     verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
     edge_source = source.astype(np.int32)
@@ -185,8 +215,7 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     if not polygons:
         raise InvalidDomainError("the domain has no polygon to mesh")
     names = [f"polygon {k}" if len(polygons) > 1 else "the polygon" for k in range(len(polygons))]
-    for k, p in enumerate(polygons):
-        check_polygon(p, names[k])
+    checked = [check_polygon(p, names[k]) for k, p in enumerate(polygons)]
     # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
     # copy), so it is not computed: check_polygon's validity holds for what is meshed
     valid = len(polygons) == 1
@@ -199,10 +228,14 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     else:
         union = shapely.union_all(polygons)
     check_lines_inside(polygons, lines, line_names, points, tolerance, union)
+    coords = None
+    if len(checked) == 1:  # the union is the polygon: its coordinates and area are known
+        coords, area = checked[0][0], float(checked[0][1])
+    else:
+        area = float(union.area)
     if isinstance(union, Polygon):
         polygons, names = [union], ["the polygon"]
-    area = float(union.area)
-    return _from_shapely(polygons, lines, line_names, points, names, tolerance, valid, area)
+    return _from_shapely(polygons, lines, line_names, points, names, tolerance, valid, area, coords)
 
 
 def from_ring(arr: np.ndarray, tolerance: float = 0.0) -> Domain:

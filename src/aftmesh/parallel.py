@@ -13,7 +13,6 @@ as a :class:`MeshingFailure` while the other domains still mesh.
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import copy
 import itertools
 import os
@@ -24,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._typing import SizeArg
+from ._workers import run_threads
 from .errors import InvalidOptionError
 from .mesh import Mesh
 
@@ -46,9 +46,14 @@ _ARRAYS = (
 
 _SCHEDULERS = ("threads", "dask", "serial")
 _ERRORS = ("raise", "collect")
-# Tasks kept in flight per worker: enough that no worker waits for the driver to hand
-# it the next domain, few enough that a lazy iterable of domains is not read far ahead.
+# Domains taken per worker but not yet handed to the caller (threads), or tasks kept in
+# flight per worker (Dask): enough that no worker waits for the driver, few enough
+# that a lazy iterable of domains is not read far ahead.
 IN_FLIGHT_PER_WORKER = 4
+# generate_many without a progress callback wakes the calling thread once per this
+# many finished domains (each wake-up takes the GIL from a worker); a failing domain
+# is then raised at most this many domains late.
+RESULTS_PER_WAKE = 32
 
 
 @dataclass(frozen=True)
@@ -185,26 +190,13 @@ def _serial(items, options, chunksize) -> Iterator[tuple[int, Any]]:
         yield i, _mesh_one(i, d, s, options)
 
 
-def _threads(items, options, workers, chunksize) -> Iterator[tuple[int, Any]]:
-    """A thread pool with a bounded window of submitted domains."""
-    window = workers * IN_FLIGHT_PER_WORKER
-    with cf.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="aftmesh") as pool:
-        pending: dict = {}
-        items = iter(items)
-        try:
-            while True:
-                for i, d, s in items:
-                    pending[pool.submit(_mesh_one, i, d, s, options)] = i
-                    if len(pending) >= window:
-                        break
-                if not pending:
-                    return
-                done, _ = cf.wait(pending, return_when=cf.FIRST_COMPLETED)
-                for fut in done:
-                    yield pending.pop(fut), fut.result()
-        finally:
-            for fut in pending:
-                fut.cancel()
+def _threads(items, options, workers, batched) -> Iterator[tuple[int, Any]]:
+    """Worker threads that take the domains themselves: a bounded window ahead, or,
+    `batched` (all results wanted at once), unbounded with results handed over in
+    batches."""
+    if batched:
+        return run_threads(items, options, workers, _mesh_one, None, RESULTS_PER_WAKE)
+    return run_threads(items, options, workers, _mesh_one, workers * IN_FLIGHT_PER_WORKER)
 
 
 def _batches(items, chunksize):
@@ -282,6 +274,14 @@ def imap_many(
     >>> sorted(i for i, mesh in aftmesh.imap_many(squares, size=0.5, workers=2))
     [0, 1, 2]
     """
+    run = (scheduler, workers, client, chunksize, options)
+    return _imap(domains, size, run, errors, progress, batched=False)
+
+
+def _imap(domains, size, run, errors, progress, batched):
+    """imap_many's stream; `batched`: the caller wants all results at once (see
+    _threads)."""
+    scheduler, workers, client, chunksize, options = run
     if client is not None and scheduler == "threads":
         scheduler = "dask"
     _check(scheduler, errors, workers, chunksize, client)
@@ -289,14 +289,16 @@ def imap_many(
     items = _pairs(domains, size)
     if scheduler == "dask":
         client = dask_client(client)
-    return _results(items, total, scheduler, workers, client, errors, progress, chunksize, options)
+    run = (scheduler, workers, client, chunksize, options)
+    return _results(items, total, run, errors, progress, batched)
 
 
-def _results(items, total, scheduler, workers, client, errors, progress, chunksize, options):
+def _results(items, total, run, errors, progress, batched):
+    scheduler, workers, client, chunksize, options = run
     if scheduler == "serial":
         stream = _serial(items, options, chunksize)
     elif scheduler == "threads":
-        stream = _threads(items, options, workers or os.cpu_count() or 1, chunksize)
+        stream = _threads(items, options, workers or os.cpu_count() or 1, batched)
     else:
         stream = _dask(items, options, client, chunksize or 1)
     for done, (index, result) in enumerate(stream, start=1):
@@ -305,7 +307,8 @@ def _results(items, total, scheduler, workers, client, errors, progress, chunksi
             raise _with_index(result) from result.error
         if progress is not None:
             progress(done, total)
-        yield index, _refreeze(result)
+        # only a Mesh unpickled from a Dask worker has writeable arrays
+        yield index, _refreeze(result) if scheduler == "dask" else result
 
 
 def _length(domains) -> int | None:
@@ -386,17 +389,6 @@ def generate_many(
     >>> out[1].index, isinstance(out[1].error, aftmesh.InvalidDomainError)
     (1, True)
     """
-    out: dict[int, Any] = dict(
-        imap_many(
-            domains,
-            size,
-            workers=workers,
-            scheduler=scheduler,
-            client=client,
-            errors=errors,
-            progress=progress,
-            chunksize=chunksize,
-            **options,
-        )
-    )
+    run = (scheduler, workers, client, chunksize, options)
+    out: dict[int, Any] = dict(_imap(domains, size, run, errors, progress, progress is None))
     return [out[i] for i in range(len(out))]

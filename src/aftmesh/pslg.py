@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _kernel
-from ._order import brio_order
+from ._order import round_keys
 from ._states import TriangleState
 from .errors import CrossingSegmentsError, InvalidDomainError, InvalidInputError
 
@@ -171,17 +171,17 @@ def build_cdt(
             raise InvalidInputError(
                 f"regions[{i}] has marker {float(reg[i, 2])!r}, out of the int32 range"
             )
+    if carve is None:
+        carve = len(seg) > 0
     kernel = _kernel.Triangulation(pts, nt_hint)
     try:
-        merged = kernel.insert_points(brio_order(pts))
+        # BRIO insertion, the segments (on the vertices the points merged into), and
+        # the carve from the hull: one kernel call
+        merged, n_merged, n_split = kernel.insert_pslg(round_keys(n), seg, carve)
     except _kernel.CollinearError:
         raise InvalidDomainError(
             f"all {n} vertices are collinear: there is no triangle to make"
         ) from None
-    n_merged = int((merged != np.arange(n)).sum())
-    kseg = merged[seg] if len(seg) else seg
-    try:
-        n_split = kernel.insert_segments(np.ascontiguousarray(kseg, dtype=np.int32))
     except _kernel.CrossingError as err:
         # the kernel knows exactly which input segment the blocking edge is a piece of
         i, j = err.index, err.blocker_segment
@@ -196,9 +196,6 @@ def build_cdt(
         raise CrossingSegmentsError(
             f"segments[{i}] = [{a}, {b}] crosses another segment", (i,)
         ) from None
-    if carve is None:
-        carve = len(seg) > 0
-    kernel.carve(np.zeros((0, 2)), carve)
     for name, rows in (("holes", hole_pts), ("regions", reg[:, :2])):
         for i, (x, y) in enumerate(rows):
             state = kernel.state_at(x, y)
@@ -211,7 +208,8 @@ def build_cdt(
                 raise InvalidDomainError(
                     f"{name}[{i}] = ({x:.6g}, {y:.6g}) is not inside the domain"
                 )
-    kernel.carve(hole_pts, False)
+    if len(hole_pts):  # without holes, the carve above left nothing to do
+        kernel.carve(hole_pts, False)
     if len(reg):
         kernel.assign_regions(
             np.ascontiguousarray(reg[:, :2]), np.ascontiguousarray(reg[:, 2].astype(np.int32))

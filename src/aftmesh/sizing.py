@@ -17,6 +17,7 @@ a long thin domain or a tiny edge does not make it bigger.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -24,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from . import _kernel
-from ._order import brio_order
+from ._order import brio_order, round_keys
 from ._typing import Point2, SizeFunction
 from .errors import InvalidSizeError
 
@@ -143,8 +144,11 @@ def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> Non
 
 
 def _resolution(bounds) -> float:
-    """The spacing of doubles at the domain's largest coordinate."""
-    return float(np.spacing(float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))))
+    """The spacing of doubles at the domain's largest coordinate (math.ulp of a
+    finite magnitude below the largest double is np.spacing of it, without numpy's
+    cost per call)."""
+    (x0, y0), (x1, y1) = bounds
+    return math.ulp(max(abs(float(x0)), abs(float(y0)), abs(float(x1)), abs(float(y1))))
 
 
 def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
@@ -330,11 +334,13 @@ def make_size_field(
         # it already holds the boundary's sizes and the gradation
         return size
     constant = _parse_size(size)
-    if constant is not None:
+    if constant is not None and not constant >= MIN_SIZE_ULPS * _resolution(bounds):
         _check_resolution(np.array([constant]), None, None, bounds, "size")
     have_boundary = boundary_lengths is not None and len(boundary_lengths) > 0
     if constant is not None and (
-        not have_boundary or float(np.min(boundary_lengths)) >= CONSTANT_IF_EDGES_ABOVE * constant
+        not have_boundary
+        or np.asarray(boundary_lengths, dtype=np.float64).min()
+        >= CONSTANT_IF_EDGES_ABOVE * constant
     ):
         # the boundary asks for nothing smaller: a constant needs no background
         return SizeField(constant)
@@ -353,20 +359,26 @@ def make_size_field(
         lengths = np.concatenate([edges, lengths])
     pts = np.ascontiguousarray(pts)
     if callable(size):
-        u = _evaluate(size, pts[:, 0], pts[:, 1])
-        _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
-    else:
-        u = np.full(len(pts), np.inf if constant is None else constant)
+        return _callable_field(size, bounds, pts, lengths, gradation)
+    u = np.full(len(pts), np.inf if constant is None else constant)
+    return _numbers_field(constant, pts, u, lengths, gradation)
+
+
+def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradation):
+    """make_size_field for a callable: sampled at the background's vertices and then
+    where interpolation misses it (_resolve_callable), gradation-limited when asked,
+    with the boundary's sizes spread as in _numbers_field."""
+    u = _evaluate(size, pts[:, 0], pts[:, 1])
+    _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
     tri = _kernel.Triangulation(pts)
     tri.insert_points(brio_order(pts))
-    if callable(size):
-        pts, u = _resolve_callable(size, tri, pts, u, bounds)
-        lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
+    pts, u = _resolve_callable(size, tri, pts, u, bounds)
+    lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
     tv, nb = tri.finite_triangles()
     used = np.zeros(len(pts), dtype=bool)
     used[tv.ravel()] = True  # a point merged into an earlier one is in no triangle
     w = np.ascontiguousarray(u, dtype=np.float64)
-    if callable(size) and gradation > 1.0:
+    if gradation > 1.0:
         w = w.copy()
         _kernel.limit_gradation_mesh(pts, tv, w, float(gradation - 1.0))
     # the boundary's sizes spread at the user's gradation, or the default one if the
@@ -380,4 +392,16 @@ def make_size_field(
     if not np.isfinite(g[used]).all():
         raise InvalidSizeError("could not derive a size from the boundary")
     g[~used] = np.inf  # never read: only the triangles' vertices are
-    return SizeField(constant or 0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
+    return SizeField(0.0, pts, w, g, tv, nb, spread - 1.0, BOUNDARY_REACH)
+
+
+def _numbers_field(constant, pts: np.ndarray, u: np.ndarray, lengths: np.ndarray, gradation):
+    """make_size_field without a callable: the background, the boundary's sizes and
+    their gradation in one kernel call (the steps of _callable_field without the
+    sampling; see there for the gradation rules)."""
+    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
+    g = np.minimum(u, lengths) if gradation > 1.0 else lengths.copy()
+    tv, nb, finite = _kernel.background_field(pts, round_keys(len(pts)), g, spread - 1.0)
+    if not finite:
+        raise InvalidSizeError("could not derive a size from the boundary")
+    return SizeField(constant or 0.0, pts, u, g, tv, nb, spread - 1.0, BOUNDARY_REACH)

@@ -33,10 +33,10 @@ def validity_reason(geom: shapely.Geometry) -> str:
     return _WHERE.sub(lambda m: " at " + _xy(m.group(1), m.group(2)), reason)
 
 
-def _check_finite(poly: Polygon, where: str) -> None:
-    # one vectorized look at x and y first; the rings one by one (and z) only when
-    # that finds a problem or there is more than x and y to look at
-    if not (poly.has_z or poly.has_m) and np.isfinite(shapely.get_coordinates(poly)).all():
+def _check_finite(poly: Polygon, where: str, coords: np.ndarray) -> None:
+    # one vectorized look at x and y (coords) first; the rings one by one (and z) only
+    # when that finds a problem or there is more than x and y to look at
+    if not (poly.has_z or poly.has_m) and np.isfinite(coords).all():
         return
     for k, ring in enumerate([poly.exterior, *poly.interiors]):
         c = np.asarray(ring.coords)
@@ -81,12 +81,14 @@ def _hole_problems(poly: Polygon) -> list[str]:
     return problems
 
 
-def check_polygon(poly: Polygon, where: str) -> None:
+def check_polygon(poly: Polygon, where: str) -> tuple[np.ndarray, float]:
     """Refuse an empty, non-finite, invalid or zero-area polygon, naming each ring at
-    fault (exterior, hole k, holes i and j) and where."""
-    if poly.is_empty:
+    fault (exterior, hole k, holes i and j) and where.  Returns what it looked at: the
+    x, y coordinates (each ring closed, the exterior first) and the area."""
+    coords = shapely.get_coordinates(poly)
+    if len(coords) == 0:  # a polygon is empty exactly when it has no coordinates
         raise InvalidDomainError(f"{where} is empty")
-    _check_finite(poly, where)
+    _check_finite(poly, where, coords)
     if not poly.is_valid:
         problems = []
         outer = Polygon(poly.exterior)
@@ -96,9 +98,11 @@ def check_polygon(poly: Polygon, where: str) -> None:
         if not problems:
             problems.append(f"its rings: {validity_reason(poly)}")
         raise InvalidDomainError(f"{where} is not a valid polygon: " + "; ".join(problems))
-    if not poly.area > 0:
+    area = poly.area
+    if not area > 0:
         coords = np.asarray(poly.exterior.coords)
         raise InvalidDomainError(f"{where} has zero area (vertices {coords[:4].tolist()}...)")
+    return coords, area
 
 
 def _outside_by_rounding(outside, union, tol: float) -> bool:

@@ -1,0 +1,130 @@
+"""GIL-held CPU time per ``aftmesh.generate`` call (issues 12 and 13).
+
+``python -m benchmarks.gil`` meshes the small polygons of ``benchmarks.parallel`` (or
+``--strip``: the fixed-cost polygon of ``benchmarks.overhead``) one after the other
+and prints, per call, the CPU time of the calling thread, the part of it spent with
+the GIL released (the kernel's ``nogil`` sections, numpy's and shapely's releases),
+the rest (held: what caps the speed-up of ``generate_many`` on threads), and how many
+times the GIL was released.  CPU time, not wall time: it means the same on a busy
+machine.
+
+It works by interposing ``PyEval_SaveThread`` / ``PyEval_RestoreThread`` (through
+which Cython's ``with nogil``, numpy and shapely release the GIL) with a small shared
+library, compiled here with the C compiler (``cc``) and preloaded into a child
+process.  Linux only; nothing here is asserted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import ctypes
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+# Calls timed per round, and rounds (the minimum is printed: the least disturbed).
+CALLS = 600
+ROUNDS = 3
+# Calls before timing: imports, caches and the kernel's first allocations.
+WARM_UP = 30
+_ENV = "AFTMESH_GIL_SHIM"
+
+_SHIM = r"""
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <time.h>
+static void *(*save)(void);
+static void (*restore)(void *);
+static long long released_ns, releases;
+static __thread long long since;
+static long long cpu(void) {
+    struct timespec t; clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return t.tv_sec * 1000000000LL + t.tv_nsec;
+}
+void *PyEval_SaveThread(void) {
+    if (!save) save = (void *(*)(void))dlsym(RTLD_NEXT, "PyEval_SaveThread");
+    releases++;
+    void *state = save();
+    since = cpu();
+    return state;
+}
+void PyEval_RestoreThread(void *state) {
+    if (!restore) restore = (void (*)(void *))dlsym(RTLD_NEXT, "PyEval_RestoreThread");
+    if (since) released_ns += cpu() - since;
+    since = 0;
+    restore(state);
+}
+void gil_read(long long *out) { out[0] = released_ns; out[1] = releases; }
+"""
+
+
+def _build_shim(folder: Path) -> Path:
+    src, lib = folder / "gilshim.c", folder / "gilshim.so"
+    src.write_text(_SHIM)
+    subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", str(lib), str(src), "-ldl"], check=True)
+    return lib
+
+
+def _cases(strip: bool, n: int) -> list:
+    if strip:
+        from .overhead import overhead_outline
+
+        case = overhead_outline()
+        return [(case.polygon, case.size)] * n
+    from .parallel import SMALL_SIZE, small_polygons
+
+    return [(d, SMALL_SIZE) for d in small_polygons(n)]
+
+
+def _measure(strip: bool, calls: int, rounds: int) -> None:
+    import aftmesh
+
+    lib = ctypes.CDLL(None)
+    out = (ctypes.c_longlong * 2)()
+    cases = _cases(strip, calls)
+    for domain, size in cases[:WARM_UP]:
+        aftmesh.generate(domain, size)
+    best = None
+    for _ in range(rounds):
+        lib.gil_read(out)
+        released0, releases0 = out[0], out[1]
+        c0 = time.thread_time_ns()
+        for domain, size in cases:
+            aftmesh.generate(domain, size)
+        cpu = time.thread_time_ns() - c0
+        lib.gil_read(out)
+        row = (cpu, out[0] - released0, out[1] - releases0)
+        best = row if best is None or row[0] < best[0] else best
+    cpu, released, releases = best
+    # each gil_read call releases the GIL once itself (ctypes): not counted
+    per = 1e6 * calls  # ns -> ms per call
+    print(
+        f"{'strip-100' if strip else 'small polygons'}: {calls} calls, least CPU of {rounds} "
+        f"rounds: cpu {cpu / per:.3f} ms/call, GIL released {released / per:.3f}, "
+        f"GIL held {(cpu - released) / per:.3f} ms/call, {(releases - 1) / calls:.1f} "
+        "releases/call"
+    )
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.gil", description=__doc__)
+    parser.add_argument("--strip", action="store_true", help="the fixed-cost polygon")
+    parser.add_argument("--calls", type=int, default=CALLS)
+    parser.add_argument("--rounds", type=int, default=ROUNDS)
+    args = parser.parse_args(argv)
+    if os.environ.get(_ENV):
+        _measure(args.strip, args.calls, args.rounds)
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        lib = _build_shim(Path(tmp))
+        env = dict(os.environ, LD_PRELOAD=str(lib), **{_ENV: "1"})
+        args_given = sys.argv[1:] if argv is None else list(argv)
+        cmd = [sys.executable, "-m", "benchmarks.gil", *args_given]
+        subprocess.run(cmd, env=env, check=True)
+
+
+if __name__ == "__main__":
+    main()

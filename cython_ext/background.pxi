@@ -1,0 +1,124 @@
+# The background triangulation of a size field given by numbers (no callable): the
+# Delaunay triangulation of the input vertices and the box's corners in BRIO order,
+# its finite triangles, and the boundary's sizes spread over its edges at the
+# gradation rate, for one call of the def layer (background_field) that holds the
+# GIL only to make its arrays (src/aftmesh/sizing.py, make_size_field).  The pieces
+# also serve Triangulation.finite_triangles and limit_gradation_mesh.
+#
+# Uses: triangulation.pxi (Tri, tri_init, insert_points), ordering.pxi
+# (hilbert_keys_into), inputs.pxi (stable_order), sizing.pxi (limit_gradation_graph).
+from libc.stdlib cimport malloc, free
+from libc.math cimport INFINITY, isfinite
+
+cdef enum:
+    # the Hilbert grid of _order.brio_order (hilbert_keys' default): 2**16 cells a side
+    BRIO_HILBERT_BITS = 16
+
+
+cdef int finite_index(Tri* T, int32_t* index) noexcept nogil:
+    """index[t] = the number of live finite triangle slot t among them (-1 for the
+    others); returns how many there are."""
+    cdef int t, n = 0
+    for t in range(T.nt):
+        if T.tstate[t] != T_FREE and not is_ghost(T, t):
+            index[t] = n
+            n += 1
+        else:
+            index[t] = -1
+    return n
+
+
+cdef void finite_into(Tri* T, const int32_t* index, int32_t* tv, int32_t* nb) noexcept nogil:
+    """tv[3i + k] = vertex k of finite triangle i (counter-clockwise); nb[3i + k] = the
+    finite triangle across the edge opposite vertex k, -1 at the hull."""
+    cdef int t, k
+    for t in range(T.nt):
+        if index[t] >= 0:
+            for k in range(3):
+                tv[3 * index[t] + k] = T.tv[3 * t + k]
+                # the edge opposite vertex k is half-edge 3t + k + 1
+                nb[3 * index[t] + k] = index[T.twin[3 * t + (k + 1) % 3] // 3]
+
+
+cdef int unused_to_inf(int n, int nt, const int32_t* tv, double* g) noexcept nogil:
+    """g[v] = inf at the points in no triangle (merged into an equal one, never read);
+    returns 1 when g is finite at all the others, else 0 (or ERR_NOMEM)."""
+    cdef int i, ok = 1
+    cdef char* used = <char*> malloc(max(n, 1))
+    if used == NULL:
+        return ERR_NOMEM
+    for i in range(n):
+        used[i] = 0
+    for i in range(3 * nt):
+        used[tv[i]] = 1
+    for i in range(n):
+        if not used[i]:
+            g[i] = INFINITY
+        elif not isfinite(g[i]):
+            ok = 0
+    free(used)
+    return ok
+
+
+cdef int limit_gradation_tris(int nv, int nt, const double* xy, const int32_t* tv,
+                              double* h, double rate, double reach) noexcept nogil:
+    """limit_gradation_graph over the edges of the triangles tv (each edge seen from
+    both sides); 0 or ERR_NOMEM."""
+    cdef int t, k, a, b, res
+    cdef int32_t* start = <int32_t*> malloc((nv + 1) * sizeof(int32_t))
+    cdef int32_t* adj = <int32_t*> malloc(max(6 * nt, 1) * sizeof(int32_t))
+    cdef int32_t* fill = <int32_t*> malloc(max(nv, 1) * sizeof(int32_t))
+    if start == NULL or adj == NULL or fill == NULL:
+        free(start)
+        free(adj)
+        free(fill)
+        return ERR_NOMEM
+    for a in range(nv + 1):
+        start[a] = 0
+    for t in range(nt):
+        for k in range(3):
+            start[tv[3 * t + k] + 1] += 2
+    for a in range(nv):
+        start[a + 1] += start[a]
+        fill[a] = start[a]
+    for t in range(nt):
+        for k in range(3):
+            a = tv[3 * t + k]
+            b = tv[3 * t + (k + 1) % 3]
+            adj[fill[a]] = b
+            fill[a] += 1
+            adj[fill[b]] = a
+            fill[b] += 1
+    res = limit_gradation_graph(nv, start, adj, xy, h, rate, reach)
+    free(start)
+    free(adj)
+    free(fill)
+    return res
+
+
+cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds,
+                     int32_t* merged) noexcept nogil:
+    """Insert the n vertices of T (rows of xy) in the BRIO order of _order.brio_order
+    (rounds | Hilbert keys, stably sorted); merged as insert_points sets it (v, or
+    the earlier vertex at the same place).  Returns insert_points' code."""
+    cdef int i, res
+    cdef int64_t* keys = <int64_t*> malloc(n * sizeof(int64_t))
+    cdef int64_t* order = <int64_t*> malloc(n * sizeof(int64_t))
+    cdef int64_t* work = <int64_t*> malloc(n * sizeof(int64_t))
+    cdef int32_t* order32 = <int32_t*> malloc(n * sizeof(int32_t))
+    if keys == NULL or order == NULL or work == NULL or order32 == NULL:
+        res = ERR_NOMEM
+    else:
+        hilbert_keys_into(xy, n, BRIO_HILBERT_BITS, keys)
+        for i in range(n):
+            keys[i] |= rounds[i]
+        stable_order(keys, _key_less, n, order, work)
+        for i in range(n):
+            order32[i] = <int32_t> order[i]
+            merged[i] = i
+        res = insert_points(T, order32, n, merged)
+    free(keys)
+    free(order)
+    free(work)
+    free(order32)
+    return res
