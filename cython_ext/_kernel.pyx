@@ -34,6 +34,7 @@ from cpython.ref cimport Py_XDECREF, PyObject
 from libc.stdlib cimport malloc, free
 
 import math
+import threading
 
 import numpy as np
 
@@ -42,6 +43,8 @@ cdef extern from *:
     int AFTMESH_DEBUG_BUILD "AFTMESH_DEBUG"
 
 DEBUG = bool(AFTMESH_DEBUG_BUILD)
+# Python runs signal handlers in its main thread only (see Aft.signals_here)
+_MAIN_THREAD = threading.main_thread().ident
 
 include "predicates.pxi"
 include "triangulation.pxi"
@@ -684,6 +687,9 @@ cdef class Triangulation:
         self.A.n_steps += 1
         _raise_for(&self.T, add_triangle(&self.A, &self.T, t))
 
+    cdef void _note_thread(self):
+        self.A.signals_here = threading.get_ident() == _MAIN_THREAD
+
     def run(self, progress=None):
         """The compiled Basic_aft loop with the built-in subtasks (GIL released).
         `progress`, if given, is called now and then with the meshed fraction of the
@@ -691,6 +697,7 @@ cdef class Triangulation:
         cdef int res
         self.progress = progress
         self.A.progress = <void*> progress if progress is not None else NULL
+        self._note_thread()
         try:
             with nogil:
                 res = basic_aft_loop(&self.A, &self.T)
@@ -708,6 +715,7 @@ cdef class Triangulation:
         """Smooth the vertices first_movable.. (those Basic_aft created) for `passes`
         rounds, each followed by Delaunay flips; returns the number of moves."""
         cdef int res
+        self._note_thread()
         with nogil:
             res = smooth(&self.A, &self.T, first_movable, passes)
         _reraise_pending(&self.A)
@@ -728,6 +736,7 @@ cdef class Triangulation:
         R.offcentre = OFFCENTRE_FACTOR * 0.5 * math.sqrt((1.0 + c) / (1.0 - c))
         R.split_segments = split_segments
         R.n_corner = n_corners
+        self._note_thread()
         try:
             with nogil:
                 res = refine_mesh(&R, &self.A, &self.T)

@@ -20,6 +20,7 @@ cdef struct Aft:
     int queue_n          # items queued
     int items_n, items_cap, free_item
     int low_class       # no class below this one holds an item
+    int used_low, used_high     # the classes used since the queue was last emptied
     int order
     SizeField size
     int64_t max_triangles   # N_max of formula (4); < 0: none
@@ -41,6 +42,10 @@ cdef struct Aft:
     # reference kept alive by the owning Triangulation) every few thousand steps
     double area_total, area_meshed
     void* progress
+    # whether the thread running the loops is Python's main thread: only there can a
+    # signal handler run (elsewhere PyErr_CheckSignals does nothing), so elsewhere the
+    # loops never take the GIL back to ask
+    bint signals_here
     # the exception a signal handler raised (Ctrl-C's KeyboardInterrupt, a watchdog's
     # own exception), held here until the def layer can raise it again
     PyObject* exc_type

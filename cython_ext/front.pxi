@@ -63,10 +63,6 @@ cdef extern from "Python.h":
 
 cdef int aft_init(Aft* A) noexcept nogil:
     memset(A, 0, sizeof(Aft))
-    A.items_cap = QUEUE_INITIAL_CAP
-    A.items = <QueueItem*> malloc(A.items_cap * sizeof(QueueItem))
-    A.head = <int32_t*> malloc(QUEUE_CLASSES * sizeof(int32_t))
-    A.tail = <int32_t*> malloc(QUEUE_CLASSES * sizeof(int32_t))
     A.lr_cap = LR_INITIAL_CAP
     A.left = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
     A.right = <int32_t*> malloc(A.lr_cap * sizeof(int32_t))
@@ -74,8 +70,8 @@ cdef int aft_init(Aft* A) noexcept nogil:
     A.max_triangles = -1
     A.close_factor = DEFAULT_CLOSE_FACTOR
     A.swaps = True
-    if (A.items == NULL or A.head == NULL or A.tail == NULL or A.left == NULL
-            or A.right == NULL):
+    A.signals_here = True
+    if A.left == NULL or A.right == NULL:
         return ERR_NOMEM
     queue_clear(A)
     return 0
@@ -98,9 +94,28 @@ cdef void aft_free(Aft* A) noexcept nogil:
 # are small integers, so the queue is one first-in first-out list per class: pushing
 # and popping cost O(1), where a binary heap's sifting cost a tenth of the run time.
 
-cdef void queue_clear(Aft* A) noexcept nogil:
+cdef int _queue_alloc(Aft* A) noexcept nogil:
+    """The queue's storage, made at its first use: most triangulations (a size
+    field's background, aftmesh.cdt) never run the front.  0 or ERR_NOMEM."""
+    A.items = <QueueItem*> malloc(QUEUE_INITIAL_CAP * sizeof(QueueItem))
+    A.head = <int32_t*> malloc(QUEUE_CLASSES * sizeof(int32_t))
+    A.tail = <int32_t*> malloc(QUEUE_CLASSES * sizeof(int32_t))
+    if A.items == NULL or A.head == NULL or A.tail == NULL:
+        return ERR_NOMEM
+    A.items_cap = QUEUE_INITIAL_CAP
     memset(A.head, 0xFF, QUEUE_CLASSES * sizeof(int32_t))     # every class: -1
     memset(A.tail, 0xFF, QUEUE_CLASSES * sizeof(int32_t))
+    return 0
+
+
+cdef void queue_clear(Aft* A) noexcept nogil:
+    """Empty the queue; only the classes used since the last clear are reset."""
+    cdef int n = A.used_high - A.used_low + 1
+    if A.head != NULL and n > 0:
+        memset(&A.head[A.used_low], 0xFF, n * sizeof(int32_t))
+        memset(&A.tail[A.used_low], 0xFF, n * sizeof(int32_t))
+    A.used_low = QUEUE_CLASSES
+    A.used_high = -1
     A.queue_n = 0
     A.items_n = 0
     A.free_item = -1
@@ -131,6 +146,8 @@ cdef int queue_push(Aft* A, Tri* T, int e) noexcept nogil:
     """Queue front half-edge e at the end of its length class; 0 or ERR_NOMEM."""
     cdef int i, c
     cdef int org = T.tv[e], dst = T.tv[nxt(e)]
+    if A.head == NULL and _queue_alloc(A):
+        return ERR_NOMEM
     if A.free_item >= 0:
         i = A.free_item
         A.free_item = A.items[i].next
@@ -153,6 +170,10 @@ cdef int queue_push(Aft* A, Tri* T, int e) noexcept nogil:
     A.tail[c] = i
     if c < A.low_class:
         A.low_class = c
+    if c < A.used_low:
+        A.used_low = c
+    if c > A.used_high:
+        A.used_high = c
     A.queue_n += 1
     return 0
 
@@ -628,6 +649,8 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
 cdef int check_signals(Aft* A) noexcept nogil:
     """Run Python's signal handlers; if one raised, keep its exception in A (the def
     layer raises it again) and return ERR_INTERRUPTED."""
+    if not A.signals_here:
+        return 0
     with gil:
         if PyErr_CheckSignals() != 0:
             if A.exc_type == NULL:
@@ -654,8 +677,8 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
         if count % SIGNAL_CHECK_INTERVAL == 0:
             if check_signals(A) != 0:
                 return ERR_INTERRUPTED
-            with gil:
-                if A.progress != NULL and A.area_total > 0:
+            if A.progress != NULL and A.area_total > 0:
+                with gil:
                     try:
                         (<object> A.progress)(A.area_meshed / A.area_total)
                     except KeyboardInterrupt:
