@@ -132,31 +132,25 @@ cdef double* _f64(arr) except? NULL:
 
 # The same for arrays known to be fresh, C-contiguous and of that dtype (the
 # kernel's own outputs): the buffer is read without reshaping first.
-cdef int32_t* _i32v(object arr) except? NULL:
+cdef void* _buffer_of(object arr) except? NULL:
     cdef Py_buffer view
-    cdef int32_t* out
+    cdef void* out
     PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
-    out = <int32_t*> view.buf if view.len else NULL
+    out = view.buf if view.len else NULL
     PyBuffer_Release(&view)  # arr keeps the memory
     return out
 
 
-cdef uint8_t* _u8v(object arr) except? NULL:
-    cdef Py_buffer view
-    cdef uint8_t* out
-    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
-    out = <uint8_t*> view.buf if view.len else NULL
-    PyBuffer_Release(&view)
-    return out
+cdef inline int32_t* _i32v(object arr) except? NULL:
+    return <int32_t*> _buffer_of(arr)
 
 
-cdef double* _f64v(object arr) except? NULL:
-    cdef Py_buffer view
-    cdef double* out
-    PyObject_GetBuffer(arr, &view, PyBUF_C_CONTIGUOUS)
-    out = <double*> view.buf if view.len else NULL
-    PyBuffer_Release(&view)
-    return out
+cdef inline uint8_t* _u8v(object arr) except? NULL:
+    return <uint8_t*> _buffer_of(arr)
+
+
+cdef inline double* _f64v(object arr) except? NULL:
+    return <double*> _buffer_of(arr)
 
 
 # The named enums of halfedge.pxd, for src/aftmesh/_states.py (tests/test_states.py
@@ -1014,16 +1008,28 @@ def unique_points(const double[:, ::1] xy):
     return None if k < 0 else (first_arr[:k], inverse_arr)
 
 
+ctypedef fused _index_t:
+    int32_t
+    int64_t
+
+
+cdef int _check_pslg(const double[:, ::1] xy, const _index_t[:, ::1] seg) except -1:
+    """The argument checks of the kernel functions that take points and segments."""
+    cdef Py_ssize_t n = xy.shape[0], k
+    if xy.shape[1] != 2 or seg.shape[1] != 2:
+        raise ValueError("points and segments must have two columns")
+    for k in range(seg.shape[0]):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
+            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    return 0
+
+
 def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
     """Whether no vertex lies on the interior of a segment, no segment is repeated and
     none has equal ends (see rings_are_proper in inputs.pxi; every pair is looked at,
     so the caller keeps it to small inputs)."""
-    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
-    if xy.shape[1] != 2 or seg.shape[1] != 2:
-        raise ValueError("points and segments must have two columns")
-    for k in range(m):
-        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
-            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0]
+    _check_pslg(xy, seg)
     if m == 0:
         return True
     return rings_are_proper(&xy[0, 0], n, &seg[0, 0], m) == 1
@@ -1031,12 +1037,8 @@ def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
 
 def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):
     """The length of the shortest segment at each point (inf at a point on none)."""
-    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], k
-    if xy.shape[1] != 2 or seg.shape[1] != 2:
-        raise ValueError("points and segments must have two columns")
-    for k in range(m):
-        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n):
-            raise ValueError(f"segment {k} refers to a vertex outside 0..{n - 1}")
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0]
+    _check_pslg(xy, seg)
     out_arr = np.empty(n, dtype=np.float64)
     cdef double[::1] out = out_arr
     if n:
