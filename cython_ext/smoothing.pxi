@@ -41,26 +41,25 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
         return ERR_NOMEM
     memset(dirty, 1, T.nv)
     T.vdirty = dirty
-    res = _smooth_rounds(A, T, first_movable, passes, dirty)
+    res = _smooth_rounds(A, T, first_movable, passes)
     T.vdirty = NULL
     free(dirty)
     return res
 
 
-cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes,
-                        uint8_t* dirty) noexcept nogil:
+cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
     cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
         for v in range(first_movable, T.nv):
-            if not dirty[v]:
+            if not T.vdirty[v]:
                 continue
-            dirty[v] = 0
+            T.vdirty[v] = 0
             res = _optimize_vertex(T, v)
             if res < 0:
                 return res
             if res:
-                _mark_ring(T, v, dirty)
+                _mark_ring(T, v)
             moved_now += res
         moved += moved_now
         if check_signals(A) != 0:
@@ -70,8 +69,9 @@ cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes,
     return moved
 
 
-cdef void _mark_ring(Tri* T, int v, uint8_t* dirty) noexcept nogil:
+cdef void _mark_ring(Tri* T, int v) noexcept nogil:
     """v moved: it and its neighbours are to be judged again."""
+    cdef uint8_t* dirty = T.vdirty
     cdef int e0 = T.vhe[v], e = e0, u
     dirty[v] = 1
     if e0 < 0:

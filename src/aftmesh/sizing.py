@@ -365,6 +365,18 @@ def make_size_field(
     return _numbers_field(constant, pts, u, lengths, gradation)
 
 
+def _boundary_sizes(w: np.ndarray, lengths: np.ndarray, gradation) -> tuple[np.ndarray, float]:
+    """The sizes to spread from the background's vertices, and the gradation they
+    spread at.  The user's own size w joins the boundary's only when a gradation limit
+    is asked for (gradation > 1): with gradation=1 it is honoured as given.  The
+    boundary's sizes spread at the user's gradation, or the default one if the user
+    asked for none (size=None with gradation=1 would otherwise leave the field
+    infinite away from the boundary)."""
+    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
+    g = np.minimum(w, lengths) if gradation > 1.0 else lengths.copy()
+    return g, spread
+
+
 def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradation):
     """make_size_field for a callable: sampled at the background's vertices and then
     where interpolation misses it (_resolve_callable), gradation-limited when asked,
@@ -382,13 +394,7 @@ def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradatio
     if gradation > 1.0:
         w = w.copy()
         _kernel.limit_gradation_mesh(pts, tv, w, float(gradation - 1.0))
-    # the boundary's sizes spread at the user's gradation, or the default one if the
-    # user asked for none (size=None with gradation=1 would otherwise leave the field
-    # infinite away from the boundary)
-    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
-    # the user's own size is limited only when asked (gradation > 1): with gradation=1
-    # it is honoured as given, and only the boundary's sizes spread
-    g = np.minimum(w, lengths) if gradation > 1.0 else lengths.copy()
+    g, spread = _boundary_sizes(w, lengths, gradation)
     _kernel.limit_gradation_mesh(pts, tv, g, float(spread - 1.0))
     if not np.isfinite(g[used]).all():
         raise InvalidSizeError("could not derive a size from the boundary")
@@ -399,9 +405,8 @@ def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradatio
 def _numbers_field(constant, pts: np.ndarray, u: np.ndarray, lengths: np.ndarray, gradation):
     """make_size_field without a callable: the background, the boundary's sizes and
     their gradation in one kernel call (the steps of _callable_field without the
-    sampling; see there for the gradation rules)."""
-    spread = gradation if gradation > 1.0 else DEFAULT_GRADATION
-    g = np.minimum(u, lengths) if gradation > 1.0 else lengths.copy()
+    sampling; _boundary_sizes holds the gradation rules)."""
+    g, spread = _boundary_sizes(u, lengths, gradation)
     tv, nb, finite = _kernel.background_field(pts, round_keys(len(pts)), g, spread - 1.0)
     if not finite:
         raise InvalidSizeError("could not derive a size from the boundary")
