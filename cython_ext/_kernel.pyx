@@ -58,6 +58,7 @@ include "smoothing.pxi"
 include "optimize.pxi"
 include "refine.pxi"
 include "inputs.pxi"
+include "nearby.pxi"
 include "discretize.pxi"
 include "background.pxi"
 
@@ -1033,6 +1034,34 @@ def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
     if m == 0:
         return True
     return rings_are_proper(&xy[0, 0], n, &seg[0, 0], m) == 1
+
+
+def vertices_near_segments_pairs(const double[:, ::1] xy, const int64_t[:, ::1] seg,
+                                 double reach):
+    """(vertex, segment) index arrays (int64) of the vertices, other than a segment's
+    own ends, within reach of a segment, and some a little farther (see nearby.pxi):
+    the candidates noding.split_at_vertices judges."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0], count
+    cdef int64_t* pairs = NULL
+    _check_pslg(xy, seg)
+    if not reach >= 0.0:
+        raise ValueError(f"reach must be >= 0, got {reach!r}")
+    if n == 0 or m == 0:
+        return np.empty(0, dtype=np.int64), np.empty(0, dtype=np.int64)
+    if n + m >= NOGIL_MIN_ITEMS:
+        with nogil:
+            count = vertices_near_segments(&xy[0, 0], n, &seg[0, 0], m, reach, &pairs)
+    else:
+        count = vertices_near_segments(&xy[0, 0], n, &seg[0, 0], m, reach, &pairs)
+    if count < 0:
+        raise MemoryError()
+    try:
+        out = np.empty((count, 2), dtype=np.int64)
+        if count:
+            memcpy(<int64_t*> _buffer_of(out), pairs, 2 * count * sizeof(int64_t))
+    finally:
+        free(pairs)
+    return out[:, 0], out[:, 1]
 
 
 def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):

@@ -25,6 +25,8 @@ cdef double OPT_SKIP = 0.985
 cdef double[4] OPT_DESCENT = [0.2, 0.08, 0.03, 0.01]
 # a cost this large means a triangle turned over (or went flat) at the trial place
 cdef double OPT_INVALID = 1e300
+# a trial place must lower the cost by this fraction: rounding is not progress
+cdef double OPT_MIN_DECREASE = 1e-9
 
 
 cdef struct Ring:
@@ -183,7 +185,7 @@ cdef inline bint _better(double cost, double worst, double best_cost,
                          double worst0) noexcept nogil:
     """A trial place is better when it lowers the cost without lowering the worst
     shape below where it started."""
-    return cost < best_cost * (1.0 - 1e-9) and worst >= worst0
+    return cost < best_cost * (1.0 - OPT_MIN_DECREASE) and worst >= worst0
 
 
 cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* by,
@@ -259,17 +261,17 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
 cdef int _legalize_around(Tri* T, int v) noexcept nogil:
     """Lawson flips after v moved, starting from the edges of its triangles (the only
     ones whose four points include v).  Returns 1, or an error."""
-    cdef int e0 = T.vhe[v], e = e0, n = 0, t, res
-    if reserve_stack(T, 3 * OPT_RING_CAP):
+    cdef int e0 = T.vhe[v], e = e0, n = 0, res
+    if reserve_stack(T, 2 * OPT_RING_CAP):
         return ERR_NOMEM
     while True:
-        t = e // 3
-        T.stack[n] = 3 * t
-        T.stack[n + 1] = 3 * t + 1
-        T.stack[n + 2] = 3 * t + 2
-        n += 3
+        # the spoke leaving v and the edge opposite v: each spoke is also the edge
+        # entering v of the triangle before, so it is pushed once
+        T.stack[n] = e
+        T.stack[n + 1] = nxt(e)
+        n += 2
         e = T.twin[prv(e)]
-        if e == e0 or n >= 3 * OPT_RING_CAP:
+        if e == e0 or n >= 2 * OPT_RING_CAP:
             break
     res = legalize_meshed(T, n)
     return res if res < 0 else 1

@@ -282,3 +282,48 @@ def test_unique_points_of_many_points_is_numpy_unique():
     want, want_inverse = np.unique(pts, axis=0, return_inverse=True)
     got, inverse = unique_rows(pts)
     assert got.tobytes() == want.tobytes() and (inverse == want_inverse.reshape(-1)).all()
+
+
+# Grid coordinates at several scales: vertices exactly on segments, on their lines
+# beyond their ends, and coordinates far from the origin (where the reach is wide).
+grid_coordinate = st.integers(0, 6)
+grid_scale = st.sampled_from([1.0, 0.1, 1e-9, 3e7])
+
+
+@given(
+    st.lists(st.tuples(grid_coordinate, grid_coordinate), min_size=3, max_size=40),
+    st.lists(st.tuples(st.integers(0, 39), st.integers(0, 39)), min_size=1, max_size=30),
+    grid_scale,
+    st.sampled_from([0.0, 1e-12, 0.05]),
+)
+def test_vertices_near_segments_finds_every_vertex_within_reach(rows, pairs, scale, reach):
+    """The grid search replaces a tree query of the points within reach of each
+    segment (shapely's dwithin): it must find all of those pairs (it may find a few
+    more, which split_at_vertices then judges exactly)."""
+    import shapely
+
+    pts = np.unique(np.array(rows, dtype=np.float64) * scale, axis=0)
+    seg = np.array([(a % len(pts), b % len(pts)) for a, b in pairs], dtype=np.int64)
+    seg = np.ascontiguousarray(seg[seg[:, 0] != seg[:, 1]])
+    if len(seg) == 0:
+        return
+    reach *= scale
+    vi, si = _kernel.vertices_near_segments_pairs(pts, seg, reach)
+    got = set(zip(vi.tolist(), si.tolist()))
+    assert all(v not in seg[k] for v, k in got)  # never a segment's own end
+    lines = shapely.linestrings(np.stack([pts[seg[:, 0]], pts[seg[:, 1]]], axis=1))
+    v, k = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
+    want = {(a, b) for a, b in zip(v.tolist(), k.tolist()) if a not in seg[b]}
+    assert want <= got
+
+
+def test_vertices_near_segments_with_segments_across_the_whole_box():
+    """512 segments across the box, all through its centre: each covers a whole row
+    of the grid their number asks for, so the grid is coarsened, and the centre is
+    still found on every one of them, and the point just above it on none."""
+    y = np.arange(512) / 1024.0  # dyadic: 1 - y is exact, so the centre is exactly on
+    pts = np.r_[np.c_[np.zeros(512), y], np.c_[np.ones(512), 1.0 - y], [[0.5, 0.5]]]
+    pts = np.r_[pts, [[0.5, 0.5 + 2.0**-12]]]
+    seg = np.c_[np.arange(512), np.arange(512) + 512].astype(np.int64)
+    vi, si = _kernel.vertices_near_segments_pairs(pts, seg, 1e-12)
+    assert set(zip(vi.tolist(), si.tolist())) == {(1024, k) for k in range(512)}

@@ -21,6 +21,7 @@ from ._kernel import (
     py_orient2d,
     rings_proper,
     unique_points,
+    vertices_near_segments_pairs,
 )
 from ._order import brio_order
 from .errors import CrossingSegmentsError
@@ -36,9 +37,9 @@ __all__ = [
 # Segments still crossing after this many rounds of noding are left for the CDT to
 # report: each round only bends pieces by an ulp, so one or two rounds suffice.
 NODING_ROUNDS = 8
-# Relative reach of the candidate search for vertices on segments: shapely's own
-# point-on-line test may miss a point exactly on a segment but not representable on
-# its line, so candidates are gathered this near and then decided exactly.
+# Relative reach of the candidate search for vertices on segments: a floating-point
+# distance may miss a point exactly on a segment but not representable on its line,
+# so candidates are gathered this near and then decided exactly.
 CANDIDATE_REACH = 1e-12
 # Relative error bound of a floating-point orientation of double inputs: Shewchuk's
 # (3 + 16 eps) eps for the first stage, taken four times over for margin.
@@ -322,11 +323,14 @@ def split_at_vertices(
     if len(segs) == 0:
         return segs, src
     segs = np.asarray(segs)
-    lines = shapely.linestrings(np.stack([pts[segs[:, 0]], pts[segs[:, 1]]], axis=1))
     reach = max(tol, CANDIDATE_REACH * float(np.abs(pts).max() + 1.0))
-    vi, si = shapely.STRtree(lines).query(shapely.points(pts), predicate="dwithin", distance=reach)
-    other = (vi != segs[si, 0]) & (vi != segs[si, 1])  # each segment finds its own ends
-    vi, si = vi[other], si[other]
+    # candidates from the kernel's grid search (nearby.pxi): every vertex within reach
+    # of a segment other than its own ends, and a few a little farther
+    vi, si = vertices_near_segments_pairs(
+        np.ascontiguousarray(pts, dtype=np.float64),
+        np.ascontiguousarray(segs, dtype=np.int64),
+        reach,
+    )
     cuts: dict[int, list[int]] = {}
     if ring_source is None:
         fixed = np.bincount(segs.ravel(), minlength=len(pts)) > 1
