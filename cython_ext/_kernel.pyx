@@ -1143,6 +1143,14 @@ cdef int _check_discretize(const double[:, ::1] vertices, const int32_t[:, ::1] 
     return 0
 
 
+cdef int _store_init(SampleStore* K, Py_ssize_t m) noexcept:
+    """An empty SampleStore for m segments; -1 when out of memory (free it anyway)."""
+    K.buf = NULL
+    K.used = K.cap = 0
+    K.at = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
+    return -1 if K.at == NULL else 0
+
+
 def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
                         const double[::1] g, const int32_t[:, ::1] tv,
                         const int32_t[:, ::1] nb, double rate, double reach,
@@ -1161,20 +1169,29 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
     pieces_arr = np.empty(m, dtype=np.int64)
     cdef double[::1] cum = cum_arr
     cdef int64_t[::1] pieces = pieces_arr
-    if m:
-        with nogil:
-            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
-                                      &cum[0], &pieces[0], &n_pts)
-    if not total <= max_pieces:
-        return total, None, None
-    pts_arr = np.empty((n_pts, 2), dtype=np.float64)
-    row_arr = np.empty(n_pts, dtype=np.int64)
-    cdef double* pts = _f64v(pts_arr)
-    cdef int64_t* row = <int64_t*> _f64v(row_arr)
-    if n_pts:
-        with nogil:
-            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
-                              &cum[0], &pieces[0], pts, row)
+    cdef SampleStore K
+    cdef double* pts
+    cdef int64_t* row
+    try:
+        if _store_init(&K, m):
+            raise MemoryError()
+        if m:
+            with nogil:
+                total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
+                                          max_samples, &cum[0], &pieces[0], &n_pts, &K)
+        if total < 0.0:
+            raise MemoryError()
+        if not total <= max_pieces:
+            return total, None, None
+        pts_arr = np.empty((n_pts, 2), dtype=np.float64)
+        row_arr = np.empty(n_pts, dtype=np.int64)
+        pts = _f64v(pts_arr)
+        row = <int64_t*> _f64v(row_arr)
+        if n_pts:
+            with nogil:
+                discretize_points(&vertices[0, 0], &segments[0, 0], m, &pieces[0], pts, row, &K)
+    finally:
+        sample_store_free(&K)
     return pieces_arr, pts_arr, row_arr
 
 
@@ -1200,8 +1217,9 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     cdef double* cum = <double*> malloc(max_samples * sizeof(double))
     cdef int64_t* pieces = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
+    cdef SampleStore K
     try:
-        if cum == NULL or pieces == NULL:
+        if _store_init(&K, m) or cum == NULL or pieces == NULL:
             raise MemoryError()
         # a background makes every sample a walk; with a constant, small inputs are
         # a few microseconds (see NOGIL_MIN_ITEMS)
@@ -1209,10 +1227,12 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         if release and m:
             with nogil:
                 total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
-                                          max_samples, cum, pieces, &n_pts)
+                                          max_samples, cum, pieces, &n_pts, &K)
         elif m:
             total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
-                                      max_samples, cum, pieces, &n_pts)
+                                      max_samples, cum, pieces, &n_pts, &K)
+        if total < 0.0:
+            raise MemoryError()
         if not total <= max_pieces:
             return total, None, None
         pts_arr = np.empty((n_pts, 2), dtype=np.float64)
@@ -1221,12 +1241,10 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         keep = _u8v(keep_arr)
         if n_pts and release:
             with nogil:
-                discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
-                                  cum, pieces, pts, NULL)
+                discretize_points(&vertices[0, 0], &segments[0, 0], m, pieces, pts, NULL, &K)
                 kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
         elif n_pts:
-            discretize_points(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
-                              cum, pieces, pts, NULL)
+            discretize_points(&vertices[0, 0], &segments[0, 0], m, pieces, pts, NULL, &K)
             kept = chain_keep(&vertices[0, 0], &segments[0, 0], m, pieces, pts, keep)
         # each split segment: one piece more than its kept points
         v_out = np.empty((nv + kept, 2), dtype=np.float64)
@@ -1238,4 +1256,7 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     finally:
         free(cum)
         free(pieces)
+        sample_store_free(&K)
     return v_out, s_out, e_out
+
+

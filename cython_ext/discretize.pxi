@@ -7,10 +7,14 @@
 # predict, at least DISCRETIZE_MIN_SAMPLES, at most the caller's cap), h linear between them, whose
 # exact integral of 1/h is ds * ln(h1 / h0) / (h1 - h0) (the trapezoid rule would
 # overcount enormously next to a tiny size); a cut point is found by inverse linear
-# interpolation of the cumulative integral, as numpy.interp computes it.
+# interpolation of the cumulative integral, as numpy.interp computes it.  The counting
+# pass keeps the split segments' integrals (SampleStore), and the cut points are placed
+# on those: the size field is sampled once per segment.
 #
 # Uses: sizing.pxi (size_at, SizeField).
 from libc.math cimport log, fabs, rint, sqrt, isnan
+from libc.stdlib cimport free, realloc
+from libc.string cimport memcpy
 from sizing cimport SizeField
 
 # below this relative difference of h between two samples, 1/h is integrated as the
@@ -95,12 +99,51 @@ cdef double _inverse_interp(double x, const double* cum, int ns) noexcept nogil:
     return val
 
 
+cdef struct SampleStore:
+    # The integrals of the split segments, kept by discretize_counts for
+    # discretize_points: each as its sample count ns, then cum[0..ns).  Sampling the
+    # size field again would cost as much as the first pass, and its walks could end
+    # in another background triangle for a point on a background edge, so the cut
+    # points would follow slightly different sizes than the piece counts.
+    double* buf
+    Py_ssize_t used, cap
+    int64_t* at             # per segment: where its entry starts in buf, -1 if unsplit
+
+
+cdef void sample_store_free(SampleStore* K) noexcept nogil:
+    free(K.buf)
+    free(K.at)
+    K.buf = NULL
+    K.at = NULL
+    K.used = K.cap = 0
+
+
+cdef int _store_keep(SampleStore* K, Py_ssize_t i, const double* cum, int ns) noexcept nogil:
+    cdef double* grown
+    cdef Py_ssize_t cap = K.cap
+    while K.used + ns + 1 > cap:
+        cap = 2 * cap + 64
+    if cap != K.cap:
+        grown = <double*> realloc(K.buf, cap * sizeof(double))
+        if grown == NULL:
+            return -1
+        K.buf = grown
+        K.cap = cap
+    K.at[i] = K.used
+    K.buf[K.used] = ns
+    memcpy(&K.buf[K.used + 1], cum, ns * sizeof(double))
+    K.used += ns + 1
+    return 0
+
+
 cdef double discretize_counts(SizeField* S, const double* v, const int32_t* seg,
                               Py_ssize_t m, int max_samples, double* cum,
-                              int64_t* pieces, Py_ssize_t* n_pts) noexcept nogil:
+                              int64_t* pieces, Py_ssize_t* n_pts,
+                              SampleStore* K) noexcept nogil:
     """pieces[i] = the number of pieces of segment i (seg[2i] -> seg[2i+1] on the
-    points v) by the size (at least 1); n_pts = the split points in all.  Returns
-    the total number of pieces (a float: it may exceed any integer type)."""
+    points v) by the size (at least 1); n_pts = the split points in all; the split
+    segments' integrals into K (its `at` allocated for m segments).  Returns the total number of pieces (a float: it may exceed any integer type), or
+    -1 when out of memory."""
     cdef Py_ssize_t i
     cdef int ns
     cdef double total = 0.0, c
@@ -115,26 +158,31 @@ cdef double discretize_counts(SizeField* S, const double* v, const int32_t* seg,
         pieces[i] = <int64_t> c if c >= 1.0 else 1
         total += c if c >= 1.0 else 1.0
         n_pts[0] += pieces[i] - 1
+        K.at[i] = -1
+        if pieces[i] > 1 and _store_keep(K, i, cum, ns):
+            return -1.0
     return total
 
 
-cdef void discretize_points(SizeField* S, const double* v, const int32_t* seg,
-                            Py_ssize_t m, int max_samples, double* cum,
-                            const int64_t* pieces, double* pts, int64_t* row) noexcept nogil:
+cdef void discretize_points(const double* v, const int32_t* seg, Py_ssize_t m,
+                            const int64_t* pieces, double* pts, int64_t* row,
+                            const SampleStore* K) noexcept nogil:
     """The split points of each segment with pieces[i] > 1, segment by segment and in
-    order along each, into pts (and the segment of each into row, unless NULL)."""
+    order along each, into pts (and the segment of each into row, unless NULL), from
+    the integrals discretize_counts kept in K."""
     cdef Py_ssize_t i, k, at = 0
     cdef int ns
     cdef double t
     cdef const double* a
     cdef const double* b
+    cdef const double* cum
     for i in range(m):
         if pieces[i] == 1:
             continue
         a = &v[2 * seg[2 * i]]
         b = &v[2 * seg[2 * i + 1]]
-        ns = _sample_count(S, a, b, max_samples)
-        _inverse_size_integral(S, a, b, ns, cum)
+        ns = <int> K.buf[K.at[i]]
+        cum = &K.buf[K.at[i] + 1]
         for k in range(1, pieces[i]):
             t = _inverse_interp(cum[ns - 1] * k / pieces[i], cum, ns)
             pts[2 * at] = a[0] + t * (b[0] - a[0])
