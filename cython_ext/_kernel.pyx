@@ -1258,5 +1258,3 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         free(pieces)
         sample_store_free(&K)
     return v_out, s_out, e_out
-
-

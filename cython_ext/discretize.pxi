@@ -142,8 +142,9 @@ cdef double discretize_counts(SizeField* S, const double* v, const int32_t* seg,
                               SampleStore* K) noexcept nogil:
     """pieces[i] = the number of pieces of segment i (seg[2i] -> seg[2i+1] on the
     points v) by the size (at least 1); n_pts = the split points in all; the split
-    segments' integrals into K (its `at` allocated for m segments).  Returns the total number of pieces (a float: it may exceed any integer type), or
-    -1 when out of memory."""
+    segments' integrals into K (its `at` allocated for m segments).  Returns the
+    total number of pieces (a float: it may exceed any integer type), or -1 when out
+    of memory."""
     cdef Py_ssize_t i
     cdef int ns
     cdef double total = 0.0, c
