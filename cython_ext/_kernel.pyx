@@ -1151,6 +1151,21 @@ cdef int _store_init(SampleStore* K, Py_ssize_t m) noexcept:
     return -1 if K.at == NULL else 0
 
 
+cdef double _count_pieces(SizeField* S, const double* v, const int32_t* seg, Py_ssize_t m,
+                          int max_samples, double* cum, int64_t* pieces, Py_ssize_t* n_pts,
+                          SampleStore* K, bint release) except? -1.0:
+    """discretize_counts, without the GIL if `release`; MemoryError when it runs out."""
+    cdef double total
+    if release:
+        with nogil:
+            total = discretize_counts(S, v, seg, m, max_samples, cum, pieces, n_pts, K)
+    else:
+        total = discretize_counts(S, v, seg, m, max_samples, cum, pieces, n_pts, K)
+    if total < 0.0:
+        raise MemoryError()
+    return total
+
+
 def discretize_segments(double constant, const double[:, ::1] xy, const double[::1] w,
                         const double[::1] g, const int32_t[:, ::1] tv,
                         const int32_t[:, ::1] nb, double rate, double reach,
@@ -1176,11 +1191,8 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
         if _store_init(&K, m):
             raise MemoryError()
         if m:
-            with nogil:
-                total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
-                                          max_samples, &cum[0], &pieces[0], &n_pts, &K)
-        if total < 0.0:
-            raise MemoryError()
+            total = _count_pieces(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
+                                  &cum[0], &pieces[0], &n_pts, &K, True)
         if not total <= max_pieces:
             return total, None, None
         pts_arr = np.empty((n_pts, 2), dtype=np.float64)
@@ -1224,15 +1236,9 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         # a background makes every sample a walk; with a constant, small inputs are
         # a few microseconds (see NOGIL_MIN_ITEMS)
         release = S.nt > 0 or m >= NOGIL_MIN_ITEMS
-        if release and m:
-            with nogil:
-                total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
-                                          max_samples, cum, pieces, &n_pts, &K)
-        elif m:
-            total = discretize_counts(&S, &vertices[0, 0], &segments[0, 0], m,
-                                      max_samples, cum, pieces, &n_pts, &K)
-        if total < 0.0:
-            raise MemoryError()
+        if m:
+            total = _count_pieces(&S, &vertices[0, 0], &segments[0, 0], m, max_samples, cum,
+                                  pieces, &n_pts, &K, release)
         if not total <= max_pieces:
             return total, None, None
         pts_arr = np.empty((n_pts, 2), dtype=np.float64)
