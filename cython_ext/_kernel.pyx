@@ -470,7 +470,7 @@ cdef class Triangulation:
                 problems.append(f"vertex {v}: stale half-edge {e}")
         return problems
 
-    def arrays(self, bint include_exterior=False):
+    def arrays(self, bint include_exterior=False, bint release=False):
         """The domain's triangles as compact numpy arrays.
 
         Returns a dict: points (n, 2), triangles (t, 3) counter-clockwise, neighbors
@@ -479,7 +479,11 @@ cdef class Triangulation:
         the input segment each is a piece of (see insert_segments; -1: none), regions
         (t,), vertex_map (nv,) kernel vertex -> output vertex (-1: not in the output).
         The scratch arrays are C buffers: numpy's cost per array would exceed the
-        work on a small mesh."""
+        work on a small mesh.
+
+        With `release`, each kernel array is freed once the outputs no longer need
+        it, so the peak memory is not the kernel's and the outputs' together; the
+        triangulation is empty afterwards."""
         cdef Tri* T = &self.T
         cdef int ntri, nvo, ns, t
         cdef int32_t* vmap
@@ -502,23 +506,50 @@ cdef class Triangulation:
             regions_arr = np.empty(ntri, dtype=np.int32)
             nvo = number_output(T, keep, tri_index, vmap, _i32v(tris_arr),
                                 _i32v(regions_arr))
+            if release:             # each array freed after the last step to read it
+                free(T.tstate)
+                free(T.tregion)
+                free(T.vhe)
+                T.tstate = NULL
+                T.tregion = NULL
+                T.vhe = NULL
             points_arr = np.empty((nvo, 2), dtype=np.float64)
             output_points(T, vmap, _f64v(points_arr))
-            ns = output_edges(T, keep, tri_index, vmap, NULL, NULL, NULL)
+            if release:
+                free(T.xy)
+                T.xy = NULL
+            ns = output_segments(T, keep, vmap, NULL, NULL)
+            seg_arr = np.empty((ns, 2), dtype=np.int32)
+            seg_ids = np.empty(ns, dtype=np.int32)
+            if ns:
+                output_segments(T, keep, vmap, _i32v(seg_arr), _i32v(seg_ids))
+            if release:
+                free(T.eflag)
+                free(T.tv)
+                free(T.eseg)
+                T.eflag = NULL
+                T.tv = NULL
+                T.eseg = NULL
             nbr_arr = np.empty((ntri, 3), dtype=np.int32)
             nbr = _i32v(nbr_arr)
             for t in range(3 * ntri):
                 nbr[t] = -1
-            seg_arr = np.empty((ns, 2), dtype=np.int32)
-            seg_ids = np.empty(ns, dtype=np.int32)
-            if ntri:
-                output_edges(T, keep, tri_index, vmap, nbr, _i32v(seg_arr), _i32v(seg_ids))
+            output_neighbors(T, keep, tri_index, nbr)
         finally:
             free(keep)
             free(tri_index)
+            if release:
+                self._empty()
         return dict(points=points_arr, triangles=tris_arr, neighbors=nbr_arr,
                     segments=seg_arr, segment_ids=seg_ids,
                     regions=regions_arr, vertex_map=vmap_arr)
+
+    cdef void _empty(self):
+        """Free the triangulation and leave an empty one (no vertices, no triangles)
+        in its place, so that any later call finds consistent state."""
+        tri_free(&self.T)
+        if tri_init(&self.T, 0, 0):
+            tri_free(&self.T)       # all NULL, all counts 0: still consistent
 
     def raw(self):
         """Copies of the raw kernel arrays (for tests and debugging)."""

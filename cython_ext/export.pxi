@@ -44,30 +44,37 @@ cdef void output_points(Tri* T, const int32_t* vmap, double* pts) noexcept nogil
             pts[2 * vmap[u] + 1] = T.xy[2 * u + 1]
 
 
-cdef int output_edges(Tri* T, const uint8_t* keep, const int32_t* tri_index,
-                      const int32_t* vmap, int32_t* nbr, int32_t* segs,
-                      int32_t* ids) noexcept nogil:
-    """nbr[3i + k] = the output triangle across the edge opposite vertex k of output
-    triangle i (-1 on entry, kept where there is none); segs / ids = the input-segment
-    edges of the output, each once, with their segment ids.  With nbr == NULL only
-    counts the segments.  Returns the number of segments."""
+cdef int output_segments(Tri* T, const uint8_t* keep, const int32_t* vmap, int32_t* segs,
+                         int32_t* ids) noexcept nogil:
+    """segs / ids = the input-segment edges of the output, each once, with their
+    segment ids; with segs == NULL only counts them.  Returns the number of segments."""
     cdef int t, k, e, u, ns = 0
     for t in range(T.nt):
         if not keep[t]:
             continue
         for k in range(3):
             e = 3 * t + k
-            if nbr != NULL:
-                # the edge opposite vertex k is half-edge 3t + (k+1) % 3
-                u = T.twin[3 * t + (k + 1) % 3] // 3
-                if keep[u]:
-                    nbr[3 * tri_index[t] + k] = tri_index[u]
             if T.eflag[e] & E_SEGMENT:
                 u = T.twin[e] // 3
                 if not keep[u] or u > t:
-                    if nbr != NULL:
+                    if segs != NULL:
                         segs[2 * ns] = vmap[T.tv[e]]
                         segs[2 * ns + 1] = vmap[T.tv[nxt(e)]]
                         ids[ns] = T.eseg[e]
                     ns += 1
     return ns
+
+
+cdef void output_neighbors(Tri* T, const uint8_t* keep, const int32_t* tri_index,
+                           int32_t* nbr) noexcept nogil:
+    """nbr[3i + k] = the output triangle across the edge opposite vertex k of output
+    triangle i (-1 on entry, kept where there is none).  Reads only T.twin."""
+    cdef int t, k, u
+    for t in range(T.nt):
+        if not keep[t]:
+            continue
+        for k in range(3):
+            # the edge opposite vertex k is half-edge 3t + (k+1) % 3
+            u = T.twin[3 * t + (k + 1) % 3] // 3
+            if keep[u]:
+                nbr[3 * tri_index[t] + k] = tri_index[u]

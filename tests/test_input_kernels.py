@@ -327,3 +327,29 @@ def test_vertices_near_segments_with_segments_across_the_whole_box():
     seg = np.c_[np.arange(512), np.arange(512) + 512].astype(np.int64)
     vi, si = _kernel.vertices_near_segments_pairs(pts, seg, 1e-12)
     assert set(zip(vi.tolist(), si.tolist())) == {(1024, k) for k in range(512)}
+
+
+@pytest.mark.parametrize("n", [4, 300])
+def test_arrays_release_gives_the_same_arrays_and_leaves_an_empty_kernel(n):
+    """arrays(release=True) frees each kernel array after its last use (generate's and
+    cdt's peak memory): the same result as arrays(), and afterwards an empty
+    triangulation that answers further calls instead of reading freed memory."""
+    from aftmesh.pslg import build_cdt
+
+    rng = np.random.default_rng(n)
+    t = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    ring = np.c_[np.cos(t), np.sin(t)] * 0.3
+    square = np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+    pts = np.r_[square, ring, rng.uniform(-0.9, 0.9, (n, 2))]
+    pts = pts[(np.hypot(pts[:, 0], pts[:, 1]) > 0.35) | (np.arange(len(pts)) < 16)]
+    segs = np.r_[[[0, 1], [1, 2], [2, 3], [3, 0]], [[4 + i, 4 + (i + 1) % 12] for i in range(12)]]
+    kept = build_cdt(pts, segs, np.array([[0.0, 0.0]]), None, carve=True).kernel.arrays()
+    kernel = build_cdt(pts, segs, np.array([[0.0, 0.0]]), None, carve=True).kernel
+    released = kernel.arrays(release=True)
+    assert released.keys() == kept.keys()
+    for name in kept:
+        assert released[name].tobytes() == kept[name].tobytes(), name
+    assert len(kept["triangles"]) > 0
+    again = kernel.arrays()
+    assert all(len(again[name]) == 0 for name in ("points", "triangles", "segments"))
+    assert kernel.state_counts() == (0, 0, 0)

@@ -289,7 +289,7 @@ def assemble(
     (segment_sources), its marker (the user's ring / line / segment it lies on, or
     that source's own marker) and its boundary tag; and what happened."""
     built = boundary.built
-    a = kernel.arrays()
+    a = kernel.arrays(release=True)  # the kernel is not used after this
     pieces = a["segment_ids"]  # the kernel's provenance of each output segment
     edges = _lookup(boundary.source, pieces)
     markers = _lookup(dom.edge_source, edges)

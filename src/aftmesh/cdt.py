@@ -90,7 +90,7 @@ def cdt(
     noded = _split_crossings(vertices, segments) if crossings == "split" else None
     if noded is None:
         built = build_cdt(vertices, segments, holes, regions)
-        a = built.kernel.arrays()
+        a = built.kernel.arrays(release=True)
         to_out = a["vertex_map"][built.merged]
         markers = a["segment_ids"]  # the kernel's provenance of each output segment
         info = {"merged_vertices": built.n_merged, "vertex_map": to_out}
@@ -99,7 +99,7 @@ def cdt(
     else:
         verts, segs, src, to_noded, n_merged = noded
         built = build_cdt(verts, segs, holes, regions)
-        a = built.kernel.arrays()
+        a = built.kernel.arrays(release=True)
         noded_out = a["vertex_map"][built.merged]
         ids = a["segment_ids"]
         markers = np.where(ids >= 0, src[np.maximum(ids, 0)], -1).astype(np.int32)
