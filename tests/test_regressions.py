@@ -844,3 +844,27 @@ def test_greedy_mesh_of_nearly_cocircular_points_is_the_exact_cdt(checked):
     seg = {tuple(sorted(s)) for s in np.asarray(mesh.segments).tolist()}
     assert fd._illegal_edges(P, [tuple(t) for t in np.asarray(mesh.triangles).tolist()], seg) == 0
     fd.check_cdt_with_triangle(mesh, np.zeros((0, 2)))  # the oracle accepts it now
+
+
+def test_line_end_computed_on_an_edge_a_few_ulps_outside_is_snapped_onto_it(checked):
+    """A constraint line ending on a polygon edge at a computed point around 5e-6,
+    2.36 ulps of the largest coordinate outside the polygon: a + t (b - a) rounds by up
+    to about 3.5 ulps, but the snapping tolerance was 2, so the line was refused as
+    leaving the domain.  It is snapped onto the edge now.  Found by the fuzzer
+    (constraints+small)."""
+    poly = Polygon(
+        [
+            (-1.8202184095666599e-6, 5.514600170561331e-6),
+            (-5.032937617938958e-6, 1.8048175266998867e-6),
+            (9.837984051326983e-7, -5.7947869726118785e-6),
+            (5.762306397102825e-6, -1.4113580169836582e-21),
+        ]
+    )
+    end = (-1.7649031765065016e-7, -4.329252276664988e-6)
+    line = LineString([(4.851175334192639e-6, 0.0), end])
+    assert not poly.covers(Point(end))  # outside by rounding
+    domain = GeometryCollection([poly, line])
+    case = fd.FuzzCase("constraints+small", domain, 4e-7, {}, [poly], [line])
+    mesh = case.call()
+    fd.verify(mesh, case, check=checked)
+    assert list(end) in np.asarray(mesh.points).tolist()

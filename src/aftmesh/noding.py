@@ -34,6 +34,10 @@ __all__ = [
     "refuse_crossings",
 ]
 
+# The rounding of a + t (b - a) in ulps of the largest coordinate: b - a (up to twice
+# that coordinate) rounds by 1, the product and the sum by 1/2 and 1 more per
+# coordinate, and the two coordinates' errors add up across the line: about 3.5.
+SNAP_ULPS = 4.0
 # Segments still crossing after this many rounds of noding are left for the CDT to
 # report: each round only bends pieces by an ulp, so one or two rounds suffice.
 NODING_ROUNDS = 8
@@ -53,17 +57,17 @@ PROPER_CHECK_PAIRS = 250_000
 
 
 def snap_tolerance(pts: np.ndarray) -> float:
-    """How near a vertex must be to a segment to count as lying on it: two units in
-    the last place (ulps) of the largest coordinate.  Points computed from the input (a
-    line's end at a + t (b - a), a crossing point, the points that split an edge for
-    the size) are off by up to about one such unit, so a vertex that near an edge may
-    land on either side of it or of the pieces it is split into; splitting the edge at
-    the vertex bends it by no more than that and removes the ambiguity.  (Larger, it
-    would close gaps a valid polygon has on purpose; what it leaves, generate repairs
-    after the discretization.)"""
+    """How near a vertex must be to a segment to count as lying on it:
+    SNAP_ULPS units in the last place (ulps) of the largest coordinate.  Points
+    computed from the input (a line's end at a + t (b - a), a crossing point, the
+    points that split an edge for the size) are off their segment's line by that much
+    at most, so a vertex that near an edge may land on either side of it or of the
+    pieces it is split into; splitting the edge at the vertex bends it by no more than
+    that and removes the ambiguity.  Only free line ends and lone points are snapped:
+    a ring's corner stays, so no gap a valid polygon has on purpose is closed."""
     if len(pts) == 0:
         return 0.0
-    return 2.0 * float(np.spacing(np.abs(pts).max()))
+    return SNAP_ULPS * float(np.spacing(np.abs(pts).max()))
 
 
 def merge_and_node(
