@@ -180,6 +180,12 @@ cdef void _add_vertices(Tri* T, const double* xy, Py_ssize_t n) noexcept nogil:
         add_vertex(T, xy[2 * i], xy[2 * i + 1])
 
 
+cdef inline void _release(void** array) noexcept:
+    """Free a kernel array and leave NULL in its place, for tri_free and _empty later."""
+    free(array[0])
+    array[0] = NULL
+
+
 cdef class Triangulation:
     """A triangulation of a point set with constrained edges, held in flat arrays.
 
@@ -507,29 +513,22 @@ cdef class Triangulation:
             nvo = number_output(T, keep, tri_index, vmap, _i32v(tris_arr),
                                 _i32v(regions_arr))
             if release:             # each array freed after the last step to read it
-                free(T.tstate)
-                free(T.tregion)
-                free(T.vhe)
-                T.tstate = NULL
-                T.tregion = NULL
-                T.vhe = NULL
+                _release(<void**> &T.tstate)
+                _release(<void**> &T.tregion)
+                _release(<void**> &T.vhe)
             points_arr = np.empty((nvo, 2), dtype=np.float64)
             output_points(T, vmap, _f64v(points_arr))
             if release:
-                free(T.xy)
-                T.xy = NULL
+                _release(<void**> &T.xy)
             ns = output_segments(T, keep, vmap, NULL, NULL)
             seg_arr = np.empty((ns, 2), dtype=np.int32)
             seg_ids = np.empty(ns, dtype=np.int32)
             if ns:
                 output_segments(T, keep, vmap, _i32v(seg_arr), _i32v(seg_ids))
             if release:
-                free(T.eflag)
-                free(T.tv)
-                free(T.eseg)
-                T.eflag = NULL
-                T.tv = NULL
-                T.eseg = NULL
+                _release(<void**> &T.eflag)
+                _release(<void**> &T.tv)
+                _release(<void**> &T.eseg)
             nbr_arr = np.empty((ntri, 3), dtype=np.int32)
             nbr = _i32v(nbr_arr)
             for t in range(3 * ntri):

@@ -41,22 +41,21 @@ cdef struct Ring:
     double oy2[OPT_RING_CAP]
 
 
-cdef double _cost_at(const Ring* R, double x, double y, double* worst) noexcept nogil:
-    """Sum of 1 / shape^2 over the ring's triangles with v at (x, y) (OPT_INVALID if
-    one is flat or inverted in floating point); the worst shape goes to worst[0].
-    Each shape is _shape()'s expression term for term, so it rounds the same."""
+cdef double _cost_at(const Ring* R, double x, double y, double worst0) noexcept nogil:
+    """Sum of 1 / shape^2 over the ring's triangles with v at (x, y), or OPT_INVALID
+    as soon as one shape is below worst0 (> 0): such a place is never taken, since a
+    move may not lower the worst shape, and this also refuses flat and inverted
+    triangles.  Each shape is _shape()'s expression term for term, so it rounds the
+    same."""
     cdef int i
     cdef double ax = R.x[0] - x, ay = R.y[0] - y, bx, by, sa, s, q, cost = 0.0
     sa = ax * ax + ay * ay
-    worst[0] = 2.0
     for i in range(R.n):
         bx = R.x[i + 1] - x
         by = R.y[i + 1] - y
         s = sa + bx * bx + by * by + R.ox2[i] + R.oy2[i]
         q = 3.4641016151377544 * (ax * by - ay * bx) / s
-        if q < worst[0]:
-            worst[0] = q
-        if q <= 0.0:
+        if q < worst0:
             return OPT_INVALID
         cost += 1.0 / (q * q)
         ax = bx
@@ -101,42 +100,14 @@ cdef inline void _circumcentre(const double* a, const double* b, const double* c
     out[1] = a[1] + (bx * c2 - cx * b2) / d
 
 
-cdef bint _needs_work(Tri* T, int e0) noexcept nogil:
-    """Whether the vertex at the origin of e0 may move and is worth the work: all its
-    triangles meshed (none next to the outside), at most OPT_RING_CAP of them, and one
-    of them shaped worse than OPT_SKIP."""
-    cdef int e = e0, n = 0
-    cdef bint poor = False
-    while True:
-        if T.tv[nxt(e)] < 0 or T.tv[prv(e)] < 0 or T.tstate[e // 3] != T_MESHED:
-            return False
-        if not poor:
-            poor = _shape(P(T, T.tv[e]), P(T, T.tv[nxt(e)]),
-                          P(T, T.tv[prv(e)])) <= OPT_SKIP
-        n += 1
-        e = T.twin[prv(e)]
-        if e == e0:
-            return poor
-        if n >= OPT_RING_CAP:
-            return False
-
-
-cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* worst_q,
-                      double* mean_len) noexcept nogil:
-    """Walk around v once: gather its ring into R, and cand[0:2] Laplacian point,
-    cand[2:4] ODT point, cand[4:6] the ideal apex of the worst triangle.  Returns the
-    number of triangles, or 0 when v must stay (next to a triangle that is not meshed,
-    or too many triangles)."""
+cdef int _gather_ring(Tri* T, int v, int e0, Ring* R, double* q) noexcept nogil:
+    """Walk around v once: its ring into R and each triangle's shape into q.  Returns
+    the number of triangles, or 0 when v must stay (next to a triangle that is not
+    meshed or to the outside, or more than OPT_RING_CAP triangles)."""
     cdef int e = e0, n = 0, u, w
-    cdef double q, area, wsum = 0.0, lsum = 0.0
-    cdef double cc[2]
     cdef double* pu
     cdef double* pw
     cdef double* pv = P(T, v)
-    for n in range(6):
-        cand[n] = 0.0
-    n = 0
-    worst_q[0] = 2.0
     while True:
         u = T.tv[nxt(e)]
         w = T.tv[prv(e)]
@@ -148,6 +119,33 @@ cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* wors
         R.y[n] = pu[1]
         R.ox2[n] = (pw[0] - pu[0]) * (pw[0] - pu[0])
         R.oy2[n] = (pw[1] - pu[1]) * (pw[1] - pu[1])
+        q[n] = _shape(pv, pu, pw)
+        n += 1
+        e = T.twin[prv(e)]
+        if e == e0:
+            break
+    R.n = n
+    R.x[n] = R.x[0]
+    R.y[n] = R.y[0]
+    return n
+
+
+cdef void _candidates(const Ring* R, const double* q, const double* pv, double* cand,
+                      double* mean_len) noexcept nogil:
+    """From the gathered ring: cand[0:2] the Laplacian point, cand[2:4] the ODT point,
+    cand[4:6] the ideal apex of the worst triangle (the first of the worst shape)."""
+    cdef int i, n = R.n
+    cdef double area, wsum = 0.0, lsum = 0.0, worst = 2.0
+    cdef double cc[2]
+    cdef double pu[2]
+    cdef double pw[2]
+    for i in range(6):
+        cand[i] = 0.0
+    for i in range(n):
+        pu[0] = R.x[i]
+        pu[1] = R.y[i]
+        pw[0] = R.x[i + 1]
+        pw[1] = R.y[i + 1]
         cand[0] += pu[0]
         cand[1] += pu[1]
         area = (pu[0] - pv[0]) * (pw[1] - pv[1]) - (pu[1] - pv[1]) * (pw[0] - pv[0])
@@ -157,18 +155,10 @@ cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* wors
             cand[3] += area * cc[1]
             wsum += area
         lsum += sqrt((pu[0] - pv[0]) ** 2 + (pu[1] - pv[1]) ** 2)
-        q = _shape(pv, pu, pw)
-        if q < worst_q[0]:
-            worst_q[0] = q
+        if q[i] < worst:
+            worst = q[i]
             cand[4] = 0.5 * (pu[0] + pw[0]) - 0.8660254037844386 * (pw[1] - pu[1])
             cand[5] = 0.5 * (pu[1] + pw[1]) + 0.8660254037844386 * (pw[0] - pu[0])
-        n += 1
-        e = T.twin[prv(e)]
-        if e == e0:
-            break
-    R.n = n
-    R.x[n] = R.x[0]
-    R.y[n] = R.y[0]
     cand[0] /= n
     cand[1] /= n
     if wsum > 0.0:
@@ -178,21 +168,34 @@ cdef int _ring_points(Tri* T, int v, int e0, Ring* R, double* cand, double* wors
         cand[2] = cand[0]
         cand[3] = cand[1]
     mean_len[0] = lsum / n
-    return n
 
 
-cdef inline bint _better(double cost, double worst, double best_cost,
-                         double worst0) noexcept nogil:
-    """A trial place is better when it lowers the cost without lowering the worst
-    shape below where it started."""
-    return cost < best_cost * (1.0 - OPT_MIN_DECREASE) and worst >= worst0
+cdef double _cost_of_shapes(const double* q, int n, double* worst) noexcept nogil:
+    """_cost_at at v's own place, from the shapes _gather_ring measured there (the
+    same expressions, so the same values)."""
+    cdef int i
+    cdef double cost = 0.0
+    worst[0] = 2.0
+    for i in range(n):
+        if q[i] < worst[0]:
+            worst[0] = q[i]
+        if q[i] <= 0.0:
+            return OPT_INVALID
+        cost += 1.0 / (q[i] * q[i])
+    return cost
+
+
+cdef inline bint _better(double cost, double best_cost) noexcept nogil:
+    """A trial place is better when it lowers the cost (_cost_at has already refused
+    every place that lowers the worst shape)."""
+    return cost < best_cost * (1.0 - OPT_MIN_DECREASE)
 
 
 cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* by,
                    double* best) noexcept nogil:
     """Steps from (bx, by) against the cost's gradient, the longest that improves
     first; updates (bx, by) and best."""
-    cdef double gx, gy, g, wq, c, x, y
+    cdef double gx, gy, g, c, x, y
     cdef int k
     _cost_gradient(R, bx[0], by[0], &gx, &gy)
     g = sqrt(gx * gx + gy * gy)
@@ -201,8 +204,8 @@ cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* b
     for k in range(4):
         x = bx[0] - OPT_DESCENT[k] * L * gx / g
         y = by[0] - OPT_DESCENT[k] * L * gy / g
-        c = _cost_at(R, x, y, &wq)
-        if _better(c, wq, best[0], worst0):
+        c = _cost_at(R, x, y, worst0)
+        if _better(c, best[0]):
             bx[0] = x
             by[0] = y
             best[0] = c
@@ -213,19 +216,24 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
     """Move v to the best of the candidate places (see the top of this file) when that
     lowers the cost of its triangles without lowering their worst shape, and every
     triangle stays counter-clockwise by the exact orient2d; then restore the CDT
-    around it.  Returns 1 if v moved, 0 if not, or an error."""
-    cdef int e0 = T.vhe[v], e, k
+    around it.  A vertex that may not move (see _gather_ring), or whose triangles are
+    all shaped better than OPT_SKIP, stays.  Returns 1 if v moved, 0 if not, or an
+    error."""
+    cdef int e0 = T.vhe[v], e, k, n
     cdef Ring R
     cdef double cand[6]
-    cdef double worst0, wq, L, c, best, x, y, bx, by
+    cdef double q[OPT_RING_CAP]
+    cdef double worst0, L, c, best, x, y, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
-    if e0 < 0 or not _needs_work(T, e0):
+    if e0 < 0:
         return 0
-    if _ring_points(T, v, e0, &R, cand, &worst0, &L) == 0:
+    n = _gather_ring(T, v, e0, &R, q)
+    if n == 0:
         return 0
-    best = _cost_at(&R, cx, cy, &wq)
-    if best >= OPT_INVALID:
+    best = _cost_of_shapes(q, n, &worst0)
+    if worst0 > OPT_SKIP or best >= OPT_INVALID:
         return 0
+    _candidates(&R, q, P(T, v), cand, &L)
     bx = cx
     by = cy
     for k in range(4):
@@ -236,8 +244,8 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
             c = 0.25 if k == 2 else 0.5
             x = cx + c * (cand[4] - cx)
             y = cy + c * (cand[5] - cy)
-        c = _cost_at(&R, x, y, &wq)
-        if _better(c, wq, best, worst0):
+        c = _cost_at(&R, x, y, worst0)
+        if _better(c, best):
             best = c
             bx = x
             by = y
