@@ -68,6 +68,11 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     return 0
 
 
+# i % 3 for i < 5, by table: the walk below indexes with it several times per step,
+# and a load is cheaper than the multiply and shifts a compiled % 3 becomes
+cdef int[5] _MOD3 = [0, 1, 2, 0, 1]
+
+
 cdef inline double _side(const double* a, const double* b, double x, double y) noexcept nogil:
     # twice the signed area of (a, b, p): > 0 when p is left of a -> b (floating
     # point is enough: the result only weighs sizes, it never decides topology)
@@ -78,7 +83,7 @@ cdef int size_locate(SizeField* S, double x, double y) noexcept nogil:
     """The background triangle holding (x, y), or the last one a walk towards it
     reached (at the hull, or after as many steps as there are triangles: rounding can
     make a walk circle, and any nearby triangle gives a good enough size)."""
-    cdef int t = S.hint, step, k, j, n
+    cdef int t = S.hint, step, k, j, n, first = 0
     cdef const int32_t* v
     if t < 0 or t >= S.nt:
         t = 0
@@ -86,13 +91,14 @@ cdef int size_locate(SizeField* S, double x, double y) noexcept nogil:
         v = &S.tv[3 * t]
         n = -1
         for j in range(3):
-            k = (j + step) % 3      # rotate the first edge tried: no walk cycles for good
-            if _side(&S.xy[2 * v[(k + 1) % 3]], &S.xy[2 * v[(k + 2) % 3]], x, y) < 0.0:
+            k = _MOD3[first + j]    # rotate the first edge tried: no walk cycles for good
+            if _side(&S.xy[2 * v[_MOD3[k + 1]]], &S.xy[2 * v[_MOD3[k + 2]]], x, y) < 0.0:
                 n = S.nb[3 * t + k]
                 break
         if n < 0:
             break
         t = n
+        first = _MOD3[first + 1]    # step % 3
     S.hint = t
     return t
 
@@ -118,7 +124,7 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     t = size_locate(S, x, y)
     v = &S.tv[3 * t]
     for k in range(3):
-        lam[k] = _side(&S.xy[2 * v[(k + 1) % 3]], &S.xy[2 * v[(k + 2) % 3]], x, y)
+        lam[k] = _side(&S.xy[2 * v[_MOD3[k + 1]]], &S.xy[2 * v[_MOD3[k + 2]]], x, y)
         if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
             lam[k] = 0.0
         s += lam[k]
