@@ -853,6 +853,19 @@ cdef void _borrow_field(SizeField* S, double constant, const double[:, ::1] xy,
         S.nb = <int32_t*> &nb[0, 0]
 
 
+cdef void _field_of(SizeField* S, double constant, const double[:, ::1] xy,
+                    const double[::1] w, const double[::1] g, const int32_t[:, ::1] tv,
+                    const int32_t[:, ::1] nb, double rate, double reach) except *:
+    """S: a copy of the given field with its derived arrays (size_at reads those), to
+    be freed with size_field_free (safe to call even when this raised)."""
+    cdef SizeField view
+    memset(S, 0, sizeof(SizeField))
+    _borrow_field(&view, constant, xy, w, g, tv, nb, rate, reach)
+    if size_field_set(S, constant, view.nv, view.nt, view.xy, view.w, view.g, view.tv,
+                      view.nb, rate, reach):
+        raise MemoryError()
+
+
 def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] w,
                     const double[::1] g, const int32_t[:, ::1] tv, const int32_t[:, ::1] nb,
                     double rate, double reach, const double[::1] x, const double[::1] y):
@@ -861,12 +874,16 @@ def size_field_eval(double constant, const double[:, ::1] xy, const double[::1] 
     cdef Py_ssize_t i, n = x.shape[0]
     out_arr = np.empty(n, dtype=np.float64)
     cdef double[::1] out = out_arr
-    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     if y.shape[0] != n:
         raise ValueError("x and y must have the same length")
-    with nogil:
-        for i in range(n):
-            out[i] = size_at(&S, x[i], y[i])
+    memset(&S, 0, sizeof(SizeField))
+    try:
+        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
+        with nogil:
+            for i in range(n):
+                out[i] = size_at(&S, x[i], y[i])
+    finally:
+        size_field_free(&S)
     return out_arr
 
 
@@ -877,9 +894,13 @@ def size_field_count(double constant, const double[:, ::1] xy, const double[::1]
     background, the background's area): see sizing.pxi's count_triangles_asked."""
     cdef SizeField S
     cdef double area = 0.0, count
-    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
-    with nogil:
-        count = count_triangles_asked(&S, min_rate, unit_area, &area)
+    memset(&S, 0, sizeof(SizeField))
+    try:
+        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
+        with nogil:
+            count = count_triangles_asked(&S, min_rate, unit_area, &area)
+    finally:
+        size_field_free(&S)
     return count, area
 
 
@@ -1209,7 +1230,6 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
     cdef Py_ssize_t m = segments.shape[0], n_pts = 0
     cdef double total = 0.0
     _check_discretize(vertices, segments, max_samples)
-    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     cum_arr = np.empty(max_samples, dtype=np.float64)
     pieces_arr = np.empty(m, dtype=np.int64)
     cdef double[::1] cum = cum_arr
@@ -1217,9 +1237,11 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
     cdef SampleStore K
     cdef double* pts
     cdef int64_t* row
+    memset(&S, 0, sizeof(SizeField))     # freed in the end, whatever raised
     try:
         if _store_init(&K, m):
             raise MemoryError()
+        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
         if m:
             total = _count_pieces(&S, &vertices[0, 0], &segments[0, 0], m, max_samples,
                                   &cum[0], &pieces[0], &n_pts, &K, True)
@@ -1234,6 +1256,7 @@ def discretize_segments(double constant, const double[:, ::1] xy, const double[:
                 discretize_points(&vertices[0, 0], &segments[0, 0], m, &pieces[0], pts, row, &K)
     finally:
         sample_store_free(&K)
+        size_field_free(&S)
     return pieces_arr, pts_arr, row_arr
 
 
@@ -1256,13 +1279,14 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     _check_discretize(vertices, segments, max_samples)
     if source.shape[0] != m:
         raise ValueError("segments and source differ in length")
-    _borrow_field(&S, constant, xy, w, g, tv, nb, rate, reach)
     cdef double* cum = <double*> malloc(max_samples * sizeof(double))
     cdef int64_t* pieces = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
     cdef SampleStore K
+    memset(&S, 0, sizeof(SizeField))     # freed in the end, whatever raised
     try:
         if _store_init(&K, m) or cum == NULL or pieces == NULL:
             raise MemoryError()
+        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
         # a background makes every sample a walk; with a constant, small inputs are
         # a few microseconds (see NOGIL_MIN_ITEMS)
         release = S.nt > 0 or m >= NOGIL_MIN_ITEMS
@@ -1293,4 +1317,5 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         free(cum)
         free(pieces)
         sample_store_free(&K)
+        size_field_free(&S)
     return v_out, s_out, e_out

@@ -103,17 +103,29 @@ cdef int _queue_alloc(Aft* A) noexcept nogil:
     if A.items == NULL or A.head == NULL or A.tail == NULL:
         return ERR_NOMEM
     A.items_cap = QUEUE_INITIAL_CAP
-    memset(A.head, 0xFF, QUEUE_CLASSES * sizeof(int32_t))     # every class: -1
-    memset(A.tail, 0xFF, QUEUE_CLASSES * sizeof(int32_t))
     return 0
 
 
+cdef void _queue_cover(Aft* A, int c) noexcept nogil:
+    """Widen the classes in use, [used_low, used_high], to hold c; the classes it
+    adds start empty.  Only that range is ever read, so a run whose lengths span a
+    few octaves sets a few dozen classes, not all QUEUE_CLASSES of them."""
+    cdef int lo = c, hi = c
+    if A.used_low <= A.used_high:       # a range in use: add only what is new
+        if c < A.used_low:
+            hi = A.used_low - 1
+        else:
+            lo = A.used_high + 1
+    memset(&A.head[lo], 0xFF, (hi - lo + 1) * sizeof(int32_t))     # -1: empty
+    memset(&A.tail[lo], 0xFF, (hi - lo + 1) * sizeof(int32_t))
+    if c < A.used_low:
+        A.used_low = c
+    if c > A.used_high:
+        A.used_high = c
+
+
 cdef void queue_clear(Aft* A) noexcept nogil:
-    """Empty the queue; only the classes used since the last clear are reset."""
-    cdef int n = A.used_high - A.used_low + 1
-    if A.head != NULL and n > 0:
-        memset(&A.head[A.used_low], 0xFF, n * sizeof(int32_t))
-        memset(&A.tail[A.used_low], 0xFF, n * sizeof(int32_t))
+    """Empty the queue: no class is in use any more."""
     A.used_low = QUEUE_CLASSES
     A.used_high = -1
     A.queue_n = 0
@@ -163,6 +175,8 @@ cdef int queue_push(Aft* A, Tri* T, int e) noexcept nogil:
     A.items[i].dst = dst
     A.items[i].next = -1
     c = _length_class(A, T.xy[2 * dst] - T.xy[2 * org], T.xy[2 * dst + 1] - T.xy[2 * org + 1])
+    if c < A.used_low or c > A.used_high:
+        _queue_cover(A, c)
     if A.tail[c] >= 0:
         A.items[A.tail[c]].next = i
     else:
@@ -170,10 +184,6 @@ cdef int queue_push(Aft* A, Tri* T, int e) noexcept nogil:
     A.tail[c] = i
     if c < A.low_class:
         A.low_class = c
-    if c < A.used_low:
-        A.used_low = c
-    if c > A.used_high:
-        A.used_high = c
     A.queue_n += 1
     return 0
 

@@ -9,6 +9,10 @@ cdef struct SizeField:
     double* g           # the smallest size any source asks for there, gradation-limited
     int32_t* tv         # 3 per background triangle, counter-clockwise
     int32_t* nb         # 3 per triangle: the one across the edge opposite vertex k, -1 none
+    # derived from the above by size_field_set, so that a look-up reads one triangle's
+    # data in one place instead of chasing indices:
+    double* txy         # 6 per triangle: its corners' (x, y), in tv's order
+    int32_t* op         # 3 per triangle: the far vertex of the neighbour nb[k], -1 none
     double rate         # a vertex's size g grows by at most this per unit of distance ...
     double reach        # ... beyond this many times g from the vertex
     int32_t hint        # the triangle the last look-up ended in: the next walk starts there

@@ -33,9 +33,11 @@ cdef void size_field_free(SizeField* S) noexcept nogil:
     free(S.g)
     free(S.tv)
     free(S.nb)
+    free(S.txy)
+    free(S.op)
     free(S.vhint)
-    S.xy = S.w = S.g = NULL
-    S.tv = S.nb = S.vhint = NULL
+    S.xy = S.w = S.g = S.txy = NULL
+    S.tv = S.nb = S.op = S.vhint = NULL
     S.nv = S.nt = S.vhint_cap = 0
     S.hint = 0
 
@@ -43,7 +45,9 @@ cdef void size_field_free(SizeField* S) noexcept nogil:
 cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const double* xy,
                         const double* w, const double* g, const int32_t* tv,
                         const int32_t* nb, double rate, double reach) noexcept nogil:
-    """Replace S by copies of the given arrays (nt == 0: the constant); 0 or ERR_NOMEM."""
+    """Replace S by copies of the given arrays (nt == 0: the constant) and the arrays
+    derived from them; 0 or ERR_NOMEM."""
+    cdef int t, k, j, n
     size_field_free(S)
     S.constant = constant
     S.rate = rate
@@ -55,7 +59,10 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     S.g = <double*> malloc(nv * sizeof(double))
     S.tv = <int32_t*> malloc(3 * nt * sizeof(int32_t))
     S.nb = <int32_t*> malloc(3 * nt * sizeof(int32_t))
-    if S.xy == NULL or S.w == NULL or S.g == NULL or S.tv == NULL or S.nb == NULL:
+    S.txy = <double*> malloc(6 * nt * sizeof(double))
+    S.op = <int32_t*> malloc(3 * nt * sizeof(int32_t))
+    if (S.xy == NULL or S.w == NULL or S.g == NULL or S.tv == NULL or S.nb == NULL
+            or S.txy == NULL or S.op == NULL):
         size_field_free(S)
         return -1
     memcpy(S.xy, xy, 2 * nv * sizeof(double))
@@ -63,6 +70,17 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     memcpy(S.g, g, nv * sizeof(double))
     memcpy(S.tv, tv, 3 * nt * sizeof(int32_t))
     memcpy(S.nb, nb, 3 * nt * sizeof(int32_t))
+    for t in range(nt):
+        for k in range(3):
+            S.txy[6 * t + 2 * k] = xy[2 * tv[3 * t + k]]
+            S.txy[6 * t + 2 * k + 1] = xy[2 * tv[3 * t + k] + 1]
+            S.op[3 * t + k] = -1
+            n = nb[3 * t + k]
+            if n >= 0:
+                for j in range(3):
+                    if nb[3 * n + j] == t:
+                        S.op[3 * t + k] = tv[3 * n + j]
+                        break
     S.nv = nv
     S.nt = nt
     return 0
@@ -84,15 +102,15 @@ cdef int size_locate(SizeField* S, double x, double y) noexcept nogil:
     reached (at the hull, or after as many steps as there are triangles: rounding can
     make a walk circle, and any nearby triangle gives a good enough size)."""
     cdef int t = S.hint, step, k, j, n, first = 0
-    cdef const int32_t* v
+    cdef const double* c
     if t < 0 or t >= S.nt:
         t = 0
     for step in range(S.nt):
-        v = &S.tv[3 * t]
+        c = &S.txy[6 * t]
         n = -1
         for j in range(3):
             k = _MOD3[first + j]    # rotate the first edge tried: no walk cycles for good
-            if _side(&S.xy[2 * v[_MOD3[k + 1]]], &S.xy[2 * v[_MOD3[k + 2]]], x, y) < 0.0:
+            if _side(&c[2 * _MOD3[k + 1]], &c[2 * _MOD3[k + 2]], x, y) < 0.0:
                 n = S.nb[3 * t + k]
                 break
         if n < 0:
@@ -109,22 +127,26 @@ cdef inline double _grown(double h, double dist, double rate, double reach) noex
     return h + rate * dist if dist > 0.0 else h
 
 
-cdef inline double _cone(const SizeField* S, int v, double x, double y) noexcept nogil:
-    cdef double dx = x - S.xy[2 * v], dy = y - S.xy[2 * v + 1]
+cdef inline double _cone(const SizeField* S, int v, const double* p, double x,
+                         double y) noexcept nogil:
+    # the cone of vertex v, at p (v's coordinates)
+    cdef double dx = x - p[0], dy = y - p[1]
     return _grown(S.g[v], sqrt(dx * dx + dy * dy), S.rate, S.reach)
 
 
 cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
-    cdef int t, k, j, n, a
+    cdef int t, k, a
     cdef double lam[3]
     cdef double s = 0.0, h = 0.0, c
     cdef const int32_t* v
+    cdef const double* p
     if S.nt == 0:
         return S.constant
     t = size_locate(S, x, y)
     v = &S.tv[3 * t]
+    p = &S.txy[6 * t]
     for k in range(3):
-        lam[k] = _side(&S.xy[2 * v[_MOD3[k + 1]]], &S.xy[2 * v[_MOD3[k + 2]]], x, y)
+        lam[k] = _side(&p[2 * _MOD3[k + 1]], &p[2 * _MOD3[k + 2]], x, y)
         if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
             lam[k] = 0.0
         s += lam[k]
@@ -137,19 +159,19 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
             break
         h += lam[k] * S.w[v[k]]
     h /= s
+    # a cone is never below its vertex's g (it only grows away from the vertex, and
+    # adding a non-negative term never rounds down), so a vertex whose g is not below
+    # h cannot lower it: skipping its square root changes no result
     for k in range(3):
-        c = _cone(S, v[k], x, y)
-        if c < h:
-            h = c
-        n = S.nb[3 * t + k]
-        if n >= 0:
-            for j in range(3):
-                if S.nb[3 * n + j] == t:
-                    a = S.tv[3 * n + j]
-                    c = _cone(S, a, x, y)
-                    if c < h:
-                        h = c
-                    break
+        if S.g[v[k]] < h:
+            c = _cone(S, v[k], &p[2 * k], x, y)
+            if c < h:
+                h = c
+        a = S.op[3 * t + k]
+        if a >= 0 and S.g[a] < h:
+            c = _cone(S, a, &S.xy[2 * a], x, y)
+            if c < h:
+                h = c
     return h
 
 

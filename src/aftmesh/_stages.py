@@ -7,6 +7,7 @@ the front, the front itself, smoothing, and the :class:`~aftmesh.mesh.Mesh`.
 
 from __future__ import annotations
 
+import math
 import sys
 from dataclasses import dataclass
 
@@ -84,9 +85,9 @@ def expected_triangles(field: SizeField, area: float, gradation: float) -> float
     if field.is_constant:
         h = float(field.constant)  # > 0; Python floats overflow to inf as numpy's do
         return float(area) / (EQUILATERAL_AREA * h) / h
-    with np.errstate(over="ignore", under="ignore", divide="ignore", invalid="ignore"):
-        total, covered = size_field_count(*field.kernel_args(), MIN_ESTIMATE_RATE, EQUILATERAL_AREA)
-        return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
+    # compiled arithmetic returning Python floats: an overflow is inf, never a warning
+    total, covered = size_field_count(*field.kernel_args(), MIN_ESTIMATE_RATE, EQUILATERAL_AREA)
+    return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
 
 
 def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
@@ -217,7 +218,7 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
         )
     min_area = opts.min_area
     if min_area is None:
-        min_area = MIN_AREA_FRACTION * (np.sqrt(3) / 4) * field.h_min**2
+        min_area = MIN_AREA_FRACTION * (math.sqrt(3) / 4) * field.h_min**2
     kernel.set_size_field(*field.kernel_args())
     kernel.set_options(
         order=ORDERS[opts.order],

@@ -16,7 +16,7 @@ from .aft import Strategy
 from .domain import to_domain
 from .errors import InvalidDomainError
 from .mesh import Mesh
-from .options import DEFAULT_MIN_ANGLE, check_options
+from .options import DEFAULT_MIN_ANGLE, Options, check_options
 from .sizing import DEFAULT_GRADATION
 
 __all__ = ["generate"]
@@ -269,7 +269,7 @@ def generate(
             domain, size, partitions=k, client=client, out=out, options=options
         )
     t_start = time.perf_counter()
-    opts = check_options(**options)
+    opts = _checked(options)
     dom = to_domain(
         domain, keep_vertices=not opts.split_boundary, tolerance=opts.tolerance, repair=opts.repair
     )
@@ -295,3 +295,19 @@ def generate(
     mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing, edge_tags, refined)
     timing["total"] = time.perf_counter() - t_start
     return mesh
+
+
+# generate's own defaults of the options, and what check_options makes of them
+_KWDEFAULTS: dict = generate.__kwdefaults__ or {}
+_DEFAULTS = tuple((k, _KWDEFAULTS[k]) for k in _OPTIONS)
+_DEFAULT_OPTIONS = check_options(**dict(_DEFAULTS))
+
+
+def _checked(options: dict) -> Options:
+    """check_options(**options), or the defaults' Options (frozen: one serves every
+    call) when each option is the very default object, as when it was not given.
+    Identity, not equality: greedy=0 equals False but must still be refused."""
+    for k, default in _DEFAULTS:
+        if options[k] is not default:
+            return check_options(**options)
+    return _DEFAULT_OPTIONS

@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -104,7 +105,7 @@ class SizeField:
             return np.array([self.constant])
         return np.minimum(self.user, self.graded)
 
-    @property
+    @cached_property
     def h_min(self) -> float:
         """The smallest size anywhere (interpolation and cones never go below the
         vertices' values)."""

@@ -36,7 +36,8 @@ def validity_reason(geom: shapely.Geometry) -> str:
 def _check_finite(poly: Polygon, where: str, coords: np.ndarray) -> None:
     # one vectorized look at x and y (coords) first; the rings one by one (and z) only
     # when that finds a problem or there is more than x and y to look at
-    if not (poly.has_z or poly.has_m) and np.isfinite(coords).all():
+    # (one call for has_z and has_m: 3 or 4 ordinates when either is there)
+    if shapely.get_coordinate_dimension(poly) == 2 and np.isfinite(coords).all():
         return
     for k, ring in enumerate([poly.exterior, *poly.interiors]):
         c = np.asarray(ring.coords)
