@@ -19,6 +19,7 @@ hold the ``nogil`` kernels:
 * inputs.pxi         ring clean-up, coordinate and segment checks of the input
 * discretize.pxi     input segments split by the integral of 1/size
 * background.pxi     a size field's background triangulation and gradation, at once
+* pipeline.pxi       generate's common case, from the size field to the mesh, in one call
 
 and the declarations they share: halfedge.pxd (the triangulation struct, its
 convention, the enums and one-line helpers), sizing.pxd (SizeField) and aft.pxd
@@ -35,6 +36,7 @@ from libc.stdlib cimport malloc, free
 
 import math
 import threading
+from time import perf_counter
 
 import numpy as np
 
@@ -1319,3 +1321,7 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         sample_store_free(&K)
         size_field_free(&S)
     return v_out, s_out, e_out
+
+
+# generate's common case uses the def layer above: included last
+include "pipeline.pxi"

@@ -277,7 +277,8 @@ def _lookup(table: np.ndarray, index: np.ndarray) -> np.ndarray:
 
 def assemble(
     kernel,
-    boundary: Boundary,
+    source: np.ndarray,
+    n_merged: int,
     dom: Domain,
     field: SizeField,
     opts: Options,
@@ -288,17 +289,18 @@ def assemble(
 ) -> Mesh:
     """The Mesh: the kernel's compact arrays; for each segment its input edge
     (segment_sources), its marker (the user's ring / line / segment it lies on, or
-    that source's own marker) and its boundary tag; and what happened."""
-    built = boundary.built
+    that source's own marker) and its boundary tag; and what happened.  `source`:
+    the input edge of each boundary piece (Boundary.source); `n_merged`: the input
+    vertices merged into others (BuiltCDT.n_merged)."""
     a = kernel.arrays(release=True)  # the kernel is not used after this
     pieces = a["segment_ids"]  # the kernel's provenance of each output segment
-    edges = _lookup(boundary.source, pieces)
+    edges = _lookup(source, pieces)
     markers = _lookup(dom.edge_source, edges)
     if dom.source_markers is not None:
         markers = _lookup(dom.source_markers, markers)
     counters = kernel.counters()
     info = {
-        "merged_vertices": built.n_merged,
+        "merged_vertices": n_merged,
         "cleanup": dom.cleanup,
         "sources": dom.source_names,
         "new_vertices": counters["new_vertices"],

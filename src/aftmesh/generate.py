@@ -1,6 +1,7 @@
 """``aftmesh.generate``: a quality triangle mesh of a domain by Basic_aft.
 
-The body is the data flow of ARCHITECTURE.md, one stage per call (see ``_stages``).
+The body is the data flow of ARCHITECTURE.md, one stage per call (see ``_stages``);
+the common case runs those stages as one compiled call (see ``_common``).
 """
 
 from __future__ import annotations
@@ -10,7 +11,7 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import Any, overload
 
-from . import _stages
+from . import _common, _stages
 from ._typing import DomainArg, PathArg, SizeArg
 from .aft import Strategy
 from .domain import to_domain
@@ -276,6 +277,10 @@ def generate(
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
     edge_tags = _stages.boundary_tags(dom, opts)
+    if _common.applies(dom, size, opts):
+        mesh = _common.common_case(dom, size, opts, edge_tags, t_start)
+        if mesh is not None:
+            return mesh
     field, expected = _stages.size_field(dom, size, opts.gradation)
     t_boundary = time.perf_counter()
     boundary = _stages.boundary_cdt(dom, field, opts, expected)
@@ -292,7 +297,18 @@ def generate(
         "basic_aft": t_aft - t_cdt,
         "min_angle": t_refine - t_aft,
     }
-    mesh = _stages.assemble(kernel, boundary, dom, field, opts, moves, timing, edge_tags, refined)
+    mesh = _stages.assemble(
+        kernel,
+        boundary.source,
+        boundary.built.n_merged,
+        dom,
+        field,
+        opts,
+        moves,
+        timing,
+        edge_tags,
+        refined,
+    )
     timing["total"] = time.perf_counter() - t_start
     return mesh
 

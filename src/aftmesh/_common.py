@@ -1,0 +1,128 @@
+"""generate's common case in one kernel call.
+
+Most calls mesh one polygon (or a dict's rings) at one number size with the compiled
+subtasks.  For those, the stages of :mod:`aftmesh._stages` from the size field to the
+refined mesh run as one compiled call (``cython_ext/pipeline.pxi``), which applies the
+stages' rules in the same order, so the mesh is the one they make.  Whatever that call
+does not reproduce (a retry for rounding, region classification, a progress bar, an
+error message), it declines, and generate runs the stages instead.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from . import _stages
+from ._kernel import COMMON_RULE_COUNT, generate_common
+from ._order import CACHED_ROUNDS, round_keys
+from .boundary import MAX_SAMPLES
+from .domain_record import Domain
+from .mesh import Mesh
+from .options import MAX_TRIANGLES, ORDERS, Options
+from .sizing import (
+    BOUNDARY_REACH,
+    BOX_PAD,
+    CONSTANT_IF_EDGES_ABOVE,
+    DEFAULT_GRADATION,
+    MIN_SIZE_ULPS,
+    SizeField,
+)
+
+__all__ = ["common_case"]
+
+# The rules of sizing.py and _stages.py, in pipeline.pxi's RULE_* order.
+_RULES = np.array(
+    [
+        CONSTANT_IF_EDGES_ABOVE,
+        BOX_PAD,
+        MIN_SIZE_ULPS,
+        DEFAULT_GRADATION,
+        BOUNDARY_REACH,
+        _stages.EQUILATERAL_AREA,
+        _stages.MIN_ESTIMATE_RATE,
+        _stages.ESTIMATE_MARGIN,
+        MAX_TRIANGLES,
+        _stages.MAX_TRIANGLE_HINT,
+        _stages.MAX_PREALLOCATED,
+        MAX_SAMPLES,
+        # the default A_min over h_min^2, as prepare_front groups it
+        _stages.MIN_AREA_FRACTION * (math.sqrt(3) / 4),
+    ],
+    dtype=np.float64,
+)
+assert len(_RULES) == COMMON_RULE_COUNT
+_RULES.setflags(write=False)
+# A double holds every integer below this exactly: a larger int size takes the stages
+# (whose float() of it the compiled call would not reproduce past it).
+_EXACT_INT = 2**53
+
+
+def _is_plain_number(size) -> bool:
+    if type(size) is float:
+        return True
+    return type(size) is int and -_EXACT_INT < size < _EXACT_INT
+
+
+def applies(dom: Domain, size, opts: Options) -> bool:
+    """Whether the compiled call may take this generate call: a plain number size, the
+    compiled subtasks with split input edges, no progress bar asked for, and no holes,
+    region points or region classification (one polygon of one ring, or a dict)."""
+    return (
+        _is_plain_number(size)
+        and opts.compiled
+        and opts.split_boundary
+        and (opts.progress is None or opts.progress is False)
+        and (dom.holes is None or len(dom.holes) == 0)
+        and (dom.region_points is None or len(dom.region_points) == 0)
+        and (dom.polygons is None or (len(dom.polygons) == 1 and len(dom.source_names) == 1))
+    )
+
+
+def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> Mesh | None:
+    """The Mesh of generate by the compiled call, or None where it declines (then
+    nothing has changed, and the stages run).  The caller checked `applies`."""
+    refining = bool(opts.min_angle) and not opts.greedy and opts.swaps
+    cap, _ = opts.triangle_cap
+    out = generate_common(
+        np.ascontiguousarray(dom.vertices, dtype=np.float64),
+        np.ascontiguousarray(dom.segments, dtype=np.int32),
+        np.ascontiguousarray(dom.segment_edge, dtype=np.int32),
+        float(size),
+        float(opts.gradation),
+        float(dom.area or 0.0),
+        round_keys(CACHED_ROUNDS),
+        _RULES,
+        float(3 * cap),  # boundary_cdt's bound on the pieces
+        np.inf if opts.progress is False else _stages.PROGRESS_MIN_TRIANGLES,
+        int(ORDERS[opts.order]),
+        -1 if opts.max_triangles is None else opts.max_triangles,
+        opts.min_area,
+        opts.close_factor,
+        opts.swaps,
+        opts.greedy,
+        opts.smooth,
+        float(opts.min_angle) if refining else 0.0,
+    )
+    if out is None:
+        return None
+    kernel, source, _n_boundary, n_merged, arrays, _expected, moves, done, times = out
+    t_boundary, t_cdt, t_aft = times
+    field = SizeField(float(size)) if arrays is None else SizeField(float(size), *arrays)
+    refined = None
+    if done is not None:
+        refined = {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
+    t_refine = time.perf_counter()
+    timing = {
+        "boundary": t_boundary - t_start,
+        "cdt": t_cdt - t_boundary,
+        "basic_aft": t_aft - t_cdt,
+        "min_angle": t_refine - t_aft,
+    }
+    mesh = _stages.assemble(
+        kernel, source, n_merged, dom, field, opts, moves, timing, edge_tags, refined
+    )
+    timing["total"] = time.perf_counter() - t_start
+    return mesh

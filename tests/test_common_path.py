@@ -1,0 +1,152 @@
+"""generate's common case (one compiled call, aftmesh._common) makes exactly the mesh
+the stages make, and hands every other case to them.
+
+Each test meshes the same input twice, once as generate does and once with the common
+case switched off, and compares every array and every reported count."""
+
+import numpy as np
+import pytest
+import shapely
+from domain_cases import shapely_cases, star_polygons, triangle_sample
+from hypothesis import given
+from hypothesis import strategies as st
+from shapely.geometry import Polygon, box
+
+import aftmesh
+import aftmesh._common as common
+from aftmesh.errors import InvalidSizeError
+
+MESH_ARRAYS = ("points", "triangles", "neighbors", "segments", "regions")
+FIELD_ARRAYS = ("points", "user", "graded", "triangles", "neighbors")
+
+
+class Taken:
+    """Counts the calls the common case took (returned a mesh) and declined."""
+
+    def __init__(self, monkeypatch):
+        self.taken = self.declined = 0
+        original = common.common_case
+
+        def counting(*args):
+            mesh = original(*args)
+            if mesh is None:
+                self.declined += 1
+            else:
+                self.taken += 1
+            return mesh
+
+        monkeypatch.setattr(common, "common_case", counting)
+
+
+def _by_stages(monkeypatch, domain, size, **kw):
+    with monkeypatch.context() as m:
+        m.setattr(common, "applies", lambda *args: False)
+        return aftmesh.generate(domain, size, **kw)
+
+
+def assert_same_mesh(a, b):
+    for name in MESH_ARRAYS + ("segment_sources", "segment_markers"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert (x is None) == (y is None), name
+        if x is not None:
+            assert x.dtype == y.dtype and np.array_equal(x, y), name
+    fa, fb = a.info["size_field"], b.info["size_field"]
+    assert fa.constant == fb.constant and fa.rate == fb.rate and fa.reach == fb.reach
+    for name in FIELD_ARRAYS:
+        assert np.array_equal(getattr(fa, name), getattr(fb, name)), name
+    skip = {"timing", "size_field"}
+    assert {k: v for k, v in a.info.items() if k not in skip} == {
+        k: v for k, v in b.info.items() if k not in skip
+    }
+    assert set(a.info["timing"]) == set(b.info["timing"])
+
+
+def _compare(monkeypatch, domain, size, checked=None, **kw):
+    taken = Taken(monkeypatch)
+    mesh = aftmesh.generate(domain, size, **kw)
+    if checked is not None:
+        checked(mesh)
+    assert_same_mesh(mesh, _by_stages(monkeypatch, domain, size, **kw))
+    return taken
+
+
+# a strip whose short edges need a background field, and a square whose edges do not
+STRIP = Polygon([(0, 0), (4, 0), (4, 0.3), (2.05, 0.3), (2, 0.31), (1.95, 0.3), (0, 0.3)])
+OPTIONS = [
+    {},
+    {"min_angle": None},
+    {"min_angle": 33.0},
+    {"smooth": 0},
+    {"order": "longest"},
+    {"order": "oldest"},
+    {"greedy": True},
+    {"swaps": False},
+    {"gradation": 1.0},
+    {"gradation": 2.5},
+    {"min_area": 1e-3},
+    {"close_factor": 0.3},
+    {"max_triangles": 200},
+    {"progress": False},
+    {"tolerance": 1e-9},
+]
+
+
+@pytest.mark.parametrize("kw", OPTIONS, ids=lambda kw: ",".join(kw) or "defaults")
+@pytest.mark.parametrize("domain", [STRIP, box(0, 0, 1, 1)], ids=["strip", "square"])
+def test_common_case_makes_the_stages_mesh_under_every_option(monkeypatch, checked, domain, kw):
+    taken = _compare(monkeypatch, domain, 0.1, checked, **kw)
+    assert taken.taken == 1
+
+
+@pytest.mark.parametrize("case", shapely_cases(), ids=repr)
+def test_common_case_makes_the_stages_mesh_on_the_shapely_cases(monkeypatch, checked, case):
+    _compare(monkeypatch, case.domain, case.size, checked)
+
+
+@pytest.mark.parametrize("name", ["A", "face", "la", "double_hex"])
+def test_common_case_makes_the_stages_mesh_on_triangle_samples(monkeypatch, checked, name):
+    case = triangle_sample(name)
+    _compare(monkeypatch, case.domain, case.size, checked)
+
+
+def test_common_case_takes_rings_and_dicts_and_declines_holes(monkeypatch):
+    ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1.0]])
+    assert _compare(monkeypatch, ring, 0.2).taken == 1
+    square = {"vertices": ring, "segments": [[0, 1], [1, 2], [2, 3], [3, 0]]}
+    assert _compare(monkeypatch, square, 0.2).taken == 1
+    holed = box(0, 0, 2, 2).difference(box(0.5, 0.5, 1, 1))
+    taken = _compare(monkeypatch, holed, 0.2)
+    assert taken.taken == taken.declined == 0  # not even tried: regions to classify
+
+
+def test_common_case_declines_what_only_the_stages_report(monkeypatch):
+    # the boundary alone above max_triangles, formula (3) above it, the count
+    # estimate above the limit: the stages' messages
+    taken = Taken(monkeypatch)
+    with pytest.raises(InvalidSizeError, match="boundary alone"):
+        aftmesh.generate(box(0, 0, 1, 1), 0.1, max_triangles=1)
+    with pytest.raises(InvalidSizeError, match="formula"):
+        aftmesh.generate(box(0, 0, 1, 1), 0.1, max_triangles=20)
+    with pytest.raises(InvalidSizeError, match="asks for about"):
+        aftmesh.generate(box(0, 0, 1, 1), 1e-6)
+    assert taken.declined == 3 and taken.taken == 0
+
+
+def test_common_case_takes_only_plain_numbers(monkeypatch):
+    taken = _compare(monkeypatch, box(0, 0, 1, 1), np.float64(0.25))
+    assert taken.taken == 0
+    taken = _compare(monkeypatch, box(0, 0, 1, 1), 1)
+    assert taken.taken == 1
+
+
+@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0]))
+def test_common_case_makes_the_stages_mesh_on_random_polygons(poly, size):
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        _compare(monkeypatch, poly, size)
+
+
+@given(st.floats(1e-9, 1e-2), st.floats(0.01, 0.5))
+def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size):
+    corner = shapely.Polygon([(0, 0), (1, 0), (1, 1 - chamfer), (1 - chamfer, 1), (0, 1)])
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        _compare(monkeypatch, corner, size)
