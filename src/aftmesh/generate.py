@@ -261,16 +261,17 @@ def generate(
     >>> abs(mesh.area() - domain.area) < 1e-9
     True
     """
-    options = {k: v for k, v in locals().items() if k in _OPTIONS}
+    arguments = locals()  # the parameters only, at this point
     if partitions is not None or client is not None or out is not None:
         from .partition import generate_partitioned
 
         k = 1 if partitions is None else partitions
+        options = {name: arguments[name] for name in _OPTIONS}
         return generate_partitioned(
             domain, size, partitions=k, client=client, out=out, options=options
         )
     t_start = time.perf_counter()
-    opts = _checked(options)
+    opts = _checked(arguments)
     dom = to_domain(
         domain, keep_vertices=not opts.split_boundary, tolerance=opts.tolerance, repair=opts.repair
     )
@@ -319,11 +320,12 @@ _DEFAULTS = tuple((k, _KWDEFAULTS[k]) for k in _OPTIONS)
 _DEFAULT_OPTIONS = check_options(**dict(_DEFAULTS))
 
 
-def _checked(options: dict) -> Options:
-    """check_options(**options), or the defaults' Options (frozen: one serves every
-    call) when each option is the very default object, as when it was not given.
-    Identity, not equality: greedy=0 equals False but must still be refused."""
+def _checked(arguments: dict) -> Options:
+    """check_options of the options among generate's arguments, or the defaults'
+    Options (frozen: one serves every call) when each option is the very default
+    object, as when it was not given.  Identity, not equality: greedy=0 equals False
+    but must still be refused."""
     for k, default in _DEFAULTS:
-        if options[k] is not default:
-            return check_options(**options)
+        if arguments[k] is not default:
+            return check_options(**{name: arguments[name] for name in _OPTIONS})
     return _DEFAULT_OPTIONS

@@ -15,8 +15,10 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon
 
+from ._kernel import coordinate_problems
 from .errors import InvalidDomainError
 from .noding import snap_tolerance
+from .pslg import COORDINATE_NOT_FINITE, MAX_COORDINATE, MIN_COORDINATE
 
 __all__ = ["check_lines_inside", "check_polygon"]
 
@@ -37,7 +39,9 @@ def _check_finite(poly: Polygon, where: str, coords: np.ndarray) -> None:
     # one vectorized look at x and y (coords) first; the rings one by one (and z) only
     # when that finds a problem or there is more than x and y to look at
     # (one call for has_z and has_m: 3 or 4 ordinates when either is there)
-    if shapely.get_coordinate_dimension(poly) == 2 and np.isfinite(coords).all():
+    if shapely.get_coordinate_dimension(poly) == 2 and not (
+        coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE) & COORDINATE_NOT_FINITE
+    ):
         return
     for k, ring in enumerate([poly.exterior, *poly.interiors]):
         c = np.asarray(ring.coords)
