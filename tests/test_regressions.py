@@ -868,3 +868,24 @@ def test_line_end_computed_on_an_edge_a_few_ulps_outside_is_snapped_onto_it(chec
     mesh = case.call()
     fd.verify(mesh, case, check=checked)
     assert list(end) in np.asarray(mesh.points).tolist()
+
+
+def test_constraint_line_of_one_repeated_point_is_kept_as_a_fixed_vertex(checked):
+    # fuzz seed 212: a LineString whose vertices all coincide was dropped whole, so
+    # its point was not a mesh vertex; it is a fixed point, as a Point would be
+    x, y = 48506649.29468939, -48506649.29468939
+    tri = Polygon(
+        [
+            (48506648.41596968, -48506648.81735128),
+            (48506649.13490771, -48506649.92717763),
+            (48506649.42393836, y),
+        ]
+    )
+    for size in (0.1, lambda px, py: np.full(len(px), 0.1)):
+        mesh = checked(
+            aftmesh.generate(GeometryCollection([tri, LineString([(x, y), (x, y)])]), size)
+        )
+        assert ((mesh.points[:, 0] == x) & (mesh.points[:, 1] == y)).any()
+    square = GeometryCollection([box(0, 0, 1, 1), LineString([(0.3, 0.4)] * 3)])
+    mesh = checked(aftmesh.generate(square, 0.1, greedy=True))
+    assert ((mesh.points == [0.3, 0.4]).all(axis=1)).sum() == 1

@@ -133,6 +133,9 @@ def _with_lines(rings: tuple, lines: list, line_names: list[str], points: list):
             segs.append(np.c_[idx[:-1], idx[1:]] + n_vertices)
             edges.append(ids[: len(c) - 1] + n_edges)
             n_vertices += len(c)
+        elif len(c):  # all its vertices at one place: a fixed point, as a Point is
+            verts.append(c)
+            n_vertices += 1
         n_edges += n
     if points:
         verts.append(np.concatenate([np.asarray(p.coords)[:, :2] for p in points]))
