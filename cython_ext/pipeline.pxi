@@ -107,6 +107,17 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     return pts_arr, u_arr, g_arr, tv, nb, spread - 1.0, rules[RULE_BOUNDARY_REACH]
 
 
+cdef double _smallest_size(const double[::1] u, const double[::1] g):
+    """SizeField.h_min: the least of min(u, g) over the background's vertices."""
+    cdef Py_ssize_t i
+    cdef double h = INFINITY, x
+    for i in range(u.shape[0]):
+        x = u[i] if u[i] <= g[i] else g[i]
+        if x < h:
+            h = x
+    return h
+
+
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
                     const int32_t[::1] source, double constant, double gradation,
                     double area, object rounds, const double[::1] rules, double max_pieces,
@@ -162,7 +173,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                                           rules[RULE_EQUILATERAL_AREA])
         share = area / (covered if covered >= 1e-300 else 1e-300)
         expected = total * (share if share < 1.0 else 1.0) * rules[RULE_ESTIMATE_MARGIN]
-        h_min = float(np.minimum(field[1], field[2]).min())
+        h_min = _smallest_size(field[1], field[2])
     if not expected <= rules[RULE_MAX_TRIANGLES]:
         return None
     t_boundary = perf_counter()

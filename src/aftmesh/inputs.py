@@ -69,11 +69,14 @@ def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str], coo
     else:
         rings, holes = _rings(polygons)
         coords, ring_of = shapely.get_coordinates(rings, return_index=True)
+    n_rings = len(holes) + sum(holes)
     pts, segs, edge, mid, ring, removed = ring_chains(
-        coords, ring_of.astype(np.int64, copy=False), len(holes) + sum(holes)
+        coords, ring_of.astype(np.int64, copy=False), n_rings
     )
     ring_names = _ring_names(names, holes)
-    if removed.any():
+    # each ring keeps its coordinates but the closing one and its repeats (ints: a
+    # numpy call costs more than this on a small polygon)
+    if len(pts) != len(coords) - n_rings:
         for r in np.flatnonzero(removed).tolist():
             note.append(f"{ring_names[r]}: removed {int(removed[r])} repeated vertices")
     return pts, segs, edge, ring, mid, ring_names
