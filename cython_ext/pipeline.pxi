@@ -1,5 +1,6 @@
-# generate's common case in one call: a domain without holes, region points or
-# region classification, meshed at a constant size with the compiled subtasks.
+# generate's common case in one call: one polygon (holes allowed) or a domain without
+# holes, region points or regions, meshed at a constant size with the compiled
+# subtasks.
 #
 # It is the data flow of _stages.py (size field, count, discretization, boundary CDT,
 # front, smoothing, minimum-angle pass) with the glue between the kernel calls in C
@@ -118,14 +119,44 @@ cdef double _smallest_size(const double[::1] u, const double[::1] g):
     return h
 
 
+cdef object _inside_exterior(Triangulation tri, const int32_t[::1] piece_edge,
+                             const int32_t[::1] edge_source):
+    """prepare_front's classification of one valid polygon's pieces (region 0 inside,
+    -1 in a hole), without probing: the carve from the hull left only the inner side
+    of each exterior-ring segment (source 0), and the inside of a valid polygon is
+    connected, so it is the one piece those sides are in; every other piece lies
+    inside a hole.  (comp, region of each piece), or None when the sides are in
+    more than one piece (then the stages classify by probes)."""
+    cdef Tri* T = &tri.T
+    cdef int e, s, inside = -1
+    comp_arr, _probes, _corners = tri.components()
+    cdef int32_t[::1] comp = comp_arr
+    for e in range(3 * T.nt):
+        s = T.eseg[e]
+        if (s < 0 or not T.eflag[e] & E_SEGMENT or T.tstate[e // 3] != T_UNMESHED
+                or edge_source[piece_edge[s]] != 0):
+            continue
+        if inside >= 0 and comp[e // 3] != inside:
+            return None
+        inside = comp[e // 3]
+    if inside < 0:
+        return None
+    region_arr = np.full(len(_probes), -1, dtype=np.int32)
+    region_arr[inside] = 0
+    return comp_arr, region_arr
+
+
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
-                    const int32_t[::1] source, double constant, double gradation,
+                    const int32_t[::1] source, const int32_t[::1] edge_source,
+                    bint classify, double constant, double gradation,
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
                     int smooth_rounds, double min_angle):
     """The stages of generate from the size field to the refined mesh, for a number
-    size (see the top of pipeline.pxi).  rounds: _order.round_keys of as many points
+    size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
+    with holes, its rings the sources (edge_source: the source of each input edge),
+    the exterior ring source 0.  rounds: _order.round_keys of as many points
     as it holds; max_pieces: the most boundary pieces allowed; progress_limit: the
     triangle hint above which a progress bar may be wanted; min_angle 0: no pass.
     Returns None when the stages must run instead, else (triangulation, source of
@@ -198,6 +229,11 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
         return None
     if through:
         return None
+    if classify:
+        regions = _inside_exterior(tri, e_out, edge_source)
+        if regions is None:
+            return None
+        tri.set_regions(*regions)
     _, n_unmeshed, _ = tri.state_counts()
     if n_unmeshed == 0 or 0 <= max_triangles < n_unmeshed:
         return None

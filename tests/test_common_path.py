@@ -7,7 +7,12 @@ case switched off, and compares every array and every reported count."""
 import numpy as np
 import pytest
 import shapely
-from domain_cases import shapely_cases, star_polygons, triangle_sample
+from domain_cases import (
+    polygons_with_circular_holes,
+    shapely_cases,
+    star_polygons,
+    triangle_sample,
+)
 from hypothesis import given
 from hypothesis import strategies as st
 from shapely.geometry import Polygon, box
@@ -109,14 +114,24 @@ def test_common_case_makes_the_stages_mesh_on_triangle_samples(monkeypatch, chec
     _compare(monkeypatch, case.domain, case.size, checked)
 
 
-def test_common_case_takes_rings_and_dicts_and_declines_holes(monkeypatch):
+def test_common_case_takes_rings_dicts_and_holes_but_not_hole_points(monkeypatch):
     ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1.0]])
     assert _compare(monkeypatch, ring, 0.2).taken == 1
     square = {"vertices": ring, "segments": [[0, 1], [1, 2], [2, 3], [3, 0]]}
     assert _compare(monkeypatch, square, 0.2).taken == 1
     holed = box(0, 0, 2, 2).difference(box(0.5, 0.5, 1, 1))
-    taken = _compare(monkeypatch, holed, 0.2)
-    assert taken.taken == taken.declined == 0  # not even tried: regions to classify
+    assert _compare(monkeypatch, holed, 0.2).taken == 1
+    inner = [[0.8, 0.4], [1.2, 0.4], [1.2, 0.6], [0.8, 0.6]]
+    framed = {
+        "vertices": np.vstack([ring, inner]),
+        "segments": square["segments"] + [[4, 5], [5, 6], [6, 7], [7, 4]],
+        "holes": [[1.0, 0.5]],
+    }
+    taken = _compare(monkeypatch, framed, 0.2)
+    assert taken.taken == taken.declined == 0  # not even tried: Triangle's hole points
+    parts = [box(0, 0, 1, 1), box(1, 0, 2, 1)]
+    taken = _compare(monkeypatch, parts, 0.2)
+    assert taken.taken == taken.declined == 0  # two regions: classified by probes
 
 
 def test_common_case_declines_what_only_the_stages_report(monkeypatch):
@@ -150,3 +165,19 @@ def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size):
     corner = shapely.Polygon([(0, 0), (1, 0), (1, 1 - chamfer), (1 - chamfer, 1), (0, 1)])
     with pytest.MonkeyPatch.context() as monkeypatch:
         _compare(monkeypatch, corner, size)
+
+
+@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4]))
+def test_common_case_makes_the_stages_mesh_on_random_polygons_with_holes(poly, size):
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        _compare(monkeypatch, poly, size)
+
+
+def test_common_case_classifies_holes_touching_the_exterior_and_each_other(monkeypatch, checked):
+    outer = box(0, 0, 4, 4)
+    touching = Polygon(
+        outer.exterior.coords,
+        [[(0, 1), (1, 2), (1, 1)], [(1, 2), (2, 3), (2, 2)], [(3, 3), (4, 4), (3.5, 3)]],
+    )
+    assert touching.is_valid
+    assert _compare(monkeypatch, touching, 0.2, checked).taken == 1

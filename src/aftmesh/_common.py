@@ -1,11 +1,12 @@
 """generate's common case in one kernel call.
 
-Most calls mesh one polygon (or a dict's rings) at one number size with the compiled
-subtasks.  For those, the stages of :mod:`aftmesh._stages` from the size field to the
-refined mesh run as one compiled call (``cython_ext/pipeline.pxi``), which applies the
-stages' rules in the same order, so the mesh is the one they make.  Whatever that call
-does not reproduce (a retry for rounding, region classification, a progress bar, an
-error message), it declines, and generate runs the stages instead.
+Most calls mesh one polygon (with or without holes, or a dict's rings) at one number
+size with the compiled subtasks.  For those, the stages of :mod:`aftmesh._stages` from
+the size field to the refined mesh run as one compiled call
+(``cython_ext/pipeline.pxi``), which applies the stages' rules in the same order, so
+the mesh is the one they make.  Whatever that call does not reproduce (a retry for
+rounding, region classification by probes, a progress bar, an error message), it
+declines, and generate runs the stages instead.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import math
 import time
 
 import numpy as np
+from shapely.geometry import Polygon
 
 from . import _stages
 from ._kernel import COMMON_RULE_COUNT, generate_common
@@ -68,8 +70,9 @@ def _is_plain_number(size) -> bool:
 
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size, the
-    compiled subtasks with split input edges, no progress bar asked for, and no holes,
-    region points or region classification (one polygon of one ring, or a dict)."""
+    compiled subtasks with split input edges, no progress bar asked for, and one
+    polygon (holes allowed, no constraint lines) or a dict or .poly without holes or
+    region points."""
     return (
         _is_plain_number(size)
         and opts.compiled
@@ -77,7 +80,17 @@ def applies(dom: Domain, size, opts: Options) -> bool:
         and (opts.progress is None or opts.progress is False)
         and (dom.holes is None or len(dom.holes) == 0)
         and (dom.region_points is None or len(dom.region_points) == 0)
-        and (dom.polygons is None or (len(dom.polygons) == 1 and len(dom.source_names) == 1))
+        and (dom.polygons is None or _one_polygon_of_rings(dom))
+    )
+
+
+def _one_polygon_of_rings(dom: Domain) -> bool:
+    """One polygon whose rings are all the sources (no constraint lines): its pieces
+    are classified without probes (pipeline.pxi's _inside_exterior)."""
+    polygons = dom.polygons
+    assert polygons is not None
+    return (
+        len(polygons) == 1 and type(polygons[0]) is Polygon and dom.n_rings == len(dom.source_names)
     )
 
 
@@ -90,6 +103,8 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         np.ascontiguousarray(dom.vertices, dtype=np.float64),
         np.ascontiguousarray(dom.segments, dtype=np.int32),
         np.ascontiguousarray(dom.segment_edge, dtype=np.int32),
+        np.ascontiguousarray(dom.edge_source, dtype=np.int32),
+        dom.polygons is not None and dom.n_rings > 1,  # holes: pieces to classify
         float(size),
         float(opts.gradation),
         float(dom.area or 0.0),

@@ -35,6 +35,7 @@ class Domain:
     source_markers: np.ndarray | None = None  # the user's marker of each source
     edge_midpoints: np.ndarray | None = None  # (e, 2) the midpoint of each input edge
     report: dict = field(default_factory=dict)  # what repair / tolerance changed
+    n_rings: int = 0  # the sources numbered first that are polygon rings (shapely input)
 
     @property
     def segment_source(self) -> np.ndarray:

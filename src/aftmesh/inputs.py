@@ -186,6 +186,7 @@ def _from_shapely(
         cleanup=note,
         edge_midpoints=mids,
         report={"tolerance": report} if report else {},
+        n_rings=n_rings,
     )
 
 
