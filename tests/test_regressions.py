@@ -889,3 +889,27 @@ def test_constraint_line_of_one_repeated_point_is_kept_as_a_fixed_vertex(checked
     square = GeometryCollection([box(0, 0, 1, 1), LineString([(0.3, 0.4)] * 3)])
     mesh = checked(aftmesh.generate(square, 0.1, greedy=True))
     assert ((mesh.points == [0.3, 0.4]).all(axis=1)).sum() == 1
+
+
+def test_min_angle_pass_keeps_the_domain_whole_after_noding_crossing_pieces(checked):
+    # fuzz seed 222: a line grazing a boundary edge made boundary_cdt node the pieces,
+    # which renumbered the vertices lexicographically; the minimum-angle pass then
+    # took the first ones for the input vertices, split boundary pieces on the lines
+    # of other chains, and gave away 0.8 % of the domain
+    y0, y1, x1, x2 = 0.20000000000000004, 0.4000000000000001, 2.068353984205743, 4.136707968411486
+    ring = [(0, y0), (0, y1), (0, 0.6000000000000001), (x1, 0.6000000000000001), (x1, y1)]
+    ring += [(x2, y1), (6.205061952617228, y1), (6.205061952617228, y0), (x2, y0), (x2, 0)]
+    ring += [(x1, 0), (0, 0)]
+    lines = [
+        LineString(
+            [(2.401596330390581, 0.10835915201244486), (1.175997796114257, 0.04727925864079247)]
+        ),
+        LineString([(x1, 0.2), (5.980936868827133, y0)]),
+        LineString([(2.00001, 0.4287575736450084), (0, y1)]),
+    ]
+    domain = GeometryCollection(
+        [Polygon(ring), *lines, Point(2.928216741637258, 0.2549136305127231)]
+    )
+    mesh = checked(aftmesh.generate(domain, 0.24936012138533437))
+    assert any("crossings" in note for note in mesh.info["cleanup"])
+    assert abs(mesh.area() - Polygon(ring).area) < 1e-12

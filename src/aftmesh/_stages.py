@@ -19,6 +19,7 @@ from .boundary import discretize
 from .domain import Domain, classify_pieces, node_crossings, snap_tolerance
 from .errors import CrossingSegmentsError, InvalidDomainError, InvalidOptionError, InvalidSizeError
 from .mesh import Mesh
+from .noding import vertices_first
 from .options import MAX_TRIANGLES, ORDERS, Options
 from .pslg import BuiltCDT, build_cdt
 from .sizing import SizeField, make_size_field, per_region_size
@@ -191,6 +192,7 @@ def boundary_cdt(dom: Domain, field: SizeField, opts: Options, expected: float) 
         verts, segs, edge = node_crossings(
             verts, segs, edge, dom.cleanup, ring_source=dom.edge_is_ring
         )
+        verts, segs = vertices_first(dom.vertices, verts, segs)
         built = build(verts, segs)
         if isinstance(built, CrossingSegmentsError):
             raise _name_sources(built, dom, verts, segs, edge) from None

@@ -30,6 +30,7 @@ __all__ = [
     "snap_tolerance",
     "merge_and_node",
     "node_crossings",
+    "vertices_first",
     "split_at_vertices",
     "refuse_crossings",
 ]
@@ -397,3 +398,21 @@ def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
             f"({pts[seg[j, 0]].tolist()} -> {pts[seg[j, 1]].tolist()})",
             (i, j),
         ) from None
+
+
+def vertices_first(first: np.ndarray, verts: np.ndarray, segs: np.ndarray):
+    """The same PSLG (verts, segs) numbered with the points `first` (each one of the
+    vertices, as node_crossings keeps every input coordinate exactly) as vertices
+    0..len(first)-1, in their order, and the others after them in theirs.  Callers
+    number the input vertices first (the minimum-angle pass takes them for the ends
+    of the segment chains), and node_crossings numbers all in lexicographic order."""
+    index = {p: i for i, p in enumerate(map(tuple, verts.tolist()))}
+    head = [index.get(p, -1) for p in map(tuple, np.asarray(first).tolist())]
+    if -1 in head:  # not kept exactly after all: no numbering to restore
+        return verts, segs
+    taken = np.zeros(len(verts), dtype=bool)
+    taken[head] = True
+    order = np.concatenate([np.array(head, dtype=np.int64), np.flatnonzero(~taken)])
+    renumber = np.empty(len(verts), dtype=np.int64)
+    renumber[order] = np.arange(len(verts))
+    return verts[order], renumber[segs].astype(segs.dtype)
