@@ -130,12 +130,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
     if done is not None:
         refined = {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
     t_refine = time.perf_counter()
-    timing = {
-        "boundary": t_boundary - t_start,
-        "cdt": t_cdt - t_boundary,
-        "basic_aft": t_aft - t_cdt,
-        "min_angle": t_refine - t_aft,
-    }
+    timing = _stages.timing(t_start, t_boundary, t_cdt, t_aft, t_refine)
     mesh = _stages.assemble(
         kernel, source, n_merged, dom, field, opts, moves, timing, edge_tags, refined
     )

@@ -269,6 +269,16 @@ def refine(kernel, dom: Domain, opts: Options) -> dict | None:
     return {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
 
 
+def timing(t_start: float, t_boundary: float, t_cdt: float, t_aft: float, t_refine: float):
+    """info["timing"] from the times the stages ended (perf_counter), without total."""
+    return {
+        "boundary": t_boundary - t_start,
+        "cdt": t_cdt - t_boundary,
+        "basic_aft": t_aft - t_cdt,
+        "min_angle": t_refine - t_aft,
+    }
+
+
 def _lookup(table: np.ndarray, index: np.ndarray) -> np.ndarray:
     """table[index] as int32, -1 where index is -1 (the kernel's and the domain's
     "none"; no index is below that)."""

@@ -292,12 +292,7 @@ def generate(
     t_aft = time.perf_counter()
     refined = _stages.refine(kernel, dom, opts)
     t_refine = time.perf_counter()
-    timing = {
-        "boundary": t_boundary - t_start,
-        "cdt": t_cdt - t_boundary,
-        "basic_aft": t_aft - t_cdt,
-        "min_angle": t_refine - t_aft,
-    }
+    timing = _stages.timing(t_start, t_boundary, t_cdt, t_aft, t_refine)
     mesh = _stages.assemble(
         kernel,
         boundary.source,
