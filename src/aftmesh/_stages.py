@@ -269,7 +269,9 @@ def refine(kernel, dom: Domain, opts: Options) -> dict | None:
     return {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
 
 
-def timing(t_start: float, t_boundary: float, t_cdt: float, t_aft: float, t_refine: float):
+def timing(
+    t_start: float, t_boundary: float, t_cdt: float, t_aft: float, t_refine: float
+) -> dict[str, float]:
     """info["timing"] from the times the stages ended (perf_counter), without total."""
     return {
         "boundary": t_boundary - t_start,

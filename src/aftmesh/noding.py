@@ -400,7 +400,9 @@ def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
         ) from None
 
 
-def vertices_first(first: np.ndarray, verts: np.ndarray, segs: np.ndarray):
+def vertices_first(
+    first: np.ndarray, verts: np.ndarray, segs: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """The same PSLG (verts, segs) numbered with the points `first` (each one of the
     vertices, as node_crossings keeps every input coordinate exactly) as vertices
     0..len(first)-1, in their order, and the others after them in theirs.  Callers
