@@ -7,9 +7,10 @@
 * the ~1e7 square written with ``out=`` by the Dask workers: peak resident memory of
   the largest process against the size of the whole mesh's arrays.
 
-Wall time and the CPU time of this process (Dask workers' CPU is not in it) are
-printed as a Markdown table and written to ``benchmarks/out/parallel.md``.  Timings
-on a shared machine: read the load average printed with them.
+Each case runs its backends in turn, several rounds; the speed-ups are the medians,
+with their range, of the ratios within a round.  Wall time and the CPU time of this
+process (Dask workers' CPU is not in it) are printed as a Markdown table and written
+to ``benchmarks/out/parallel.md``, with the load average at the start and the end.
 """
 
 from __future__ import annotations
@@ -30,6 +31,10 @@ import aftmesh
 SQUARE_SIZES = {"1e6": 0.0015, "1e7": 0.00048}  # edge lengths giving ~1e6 / ~1e7 triangles
 QUICK_SIZES = {"1e5": 0.0047, "1e6": 0.0015}
 SMALL_SIZE = 0.08  # ~300 triangles per small polygon
+# rounds of each timing: the speed-ups quoted are medians over them (see _rounds)
+MANY_ROUNDS = 7
+SQUARE_ROUNDS = 3
+QUICK_ROUNDS = 2
 
 
 def small_polygons(n: int, seed: int = 0) -> list:
@@ -54,52 +59,70 @@ def _timed(fn):
     return result, time.perf_counter() - t, time.process_time() - c
 
 
-def _row(case, backend, meshes, wall, cpu, base_wall=None, base_rr=None):
-    if isinstance(meshes, aftmesh.Mesh):
-        meshes = [meshes]
-    tri = sum(m.n_triangles for m in meshes)
-    rr = (
-        float(np.mean([m.quality()["radius_ratio_mean"] for m in meshes]))
-        if len(meshes) == 1
-        else None
-    )
-    return {
-        "case": case,
-        "backend": backend,
-        "triangles": tri,
-        "wall": wall,
-        "cpu": cpu,
-        "speedup": None if base_wall is None else base_wall / wall,
-        "rr": rr,
-        "drr": None if rr is None or base_rr is None else rr - base_rr,
+def _triangles(out) -> int:
+    return out.n_triangles if isinstance(out, aftmesh.Mesh) else sum(m.n_triangles for m in out)
+
+
+def _rounds(case: str, backends: dict, repeats: int) -> list:
+    """Each backend once per round, in the same order every round, `repeats` rounds:
+    one row per backend with the median wall and CPU time, and the median and range of
+    its speed-up over the serial run of the same round (a ratio taken within a round
+    cancels most of a shared machine's slow spells; one round alone does not).  The
+    mean radius ratio is reported for a single mesh (a partitioned run against the
+    serial one)."""
+    times: dict = {name: [] for name in backends}
+    last: dict = {}
+    for _ in range(repeats):
+        for name, fn in backends.items():
+            last.pop(name, None)  # the previous round's result is not kept alive
+            last[name], wall, cpu = _timed(fn)
+            times[name].append((wall, cpu))
+    base = [w for w, _ in times["serial"]]
+    rr = {
+        name: float(out.quality()["radius_ratio_mean"])
+        for name, out in last.items()
+        if isinstance(out, aftmesh.Mesh)
     }
-
-
-def bench_many(n, client) -> list:
-    doms = small_polygons(n)
     rows = []
-    serial, w0, c0 = _timed(lambda: [aftmesh.generate(d, SMALL_SIZE) for d in doms])
-    rows.append(_row(f"{n} polygons", "serial", serial, w0, c0))
-    out, w, c = _timed(lambda: aftmesh.generate_many(doms, SMALL_SIZE, workers=2))
-    rows.append(_row(f"{n} polygons", "2 threads", out, w, c, w0))
-    out, w, c = _timed(lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=client, chunksize=25))
-    rows.append(_row(f"{n} polygons", "Dask 2 procs", out, w, c, w0))
+    for name, runs in times.items():
+        walls = [w for w, _ in runs]
+        speedups = None if name == "serial" else [s / w for s, w in zip(base, walls)]
+        rows.append(
+            {
+                "case": case,
+                "backend": name,
+                "triangles": _triangles(last[name]),
+                "rounds": len(runs),
+                "wall": float(np.median(walls)),
+                "cpu": float(np.median([c for _, c in runs])),
+                "speedup": None if speedups is None else float(np.median(speedups)),
+                "range": None if speedups is None else (min(speedups), max(speedups)),
+                "rr": rr.get(name),
+                "drr": rr[name] - rr["serial"] if name in rr and name != "serial" else None,
+            }
+        )
     return rows
 
 
-def bench_square(label, h, client) -> list:
+def bench_many(n, client, repeats: int) -> list:
+    doms = small_polygons(n)
+    backends = {
+        "serial": lambda: [aftmesh.generate(d, SMALL_SIZE) for d in doms],
+        "2 threads": lambda: aftmesh.generate_many(doms, SMALL_SIZE, workers=2),
+        # the automatic batches, as a user gets them
+        "Dask 2 procs": lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=client),
+    }
+    return _rounds(f"{n} polygons", backends, repeats)
+
+
+def bench_square(label, h, client, repeats: int) -> list:
     d = box(0, 0, 1, 1)
-    case = f"square ~{label}"
-    serial, w0, c0 = _timed(lambda: aftmesh.generate(d, h))
-    rr0 = serial.quality()["radius_ratio_mean"]
-    rows = [_row(case, "serial", serial, w0, c0, base_rr=rr0)]
-    del serial
-    m, w, c = _timed(lambda: aftmesh.generate(d, h, partitions=2))
-    rows.append(_row(case, "partitions=2, 2 threads", m, w, c, w0, rr0))
-    del m
-    m, w, c = _timed(lambda: aftmesh.generate(d, h, partitions=2, client=client))
-    rows.append(_row(case, "partitions=2, Dask 2 procs", m, w, c, w0, rr0))
-    return rows
+    backends = {
+        "serial": lambda: aftmesh.generate(d, h),
+        "partitions=2, 2 threads": lambda: aftmesh.generate(d, h, partitions=2),
+        "partitions=2, Dask 2 procs": lambda: aftmesh.generate(d, h, partitions=2, client=client),
+    }
+    return _rounds(f"square ~{label}", backends, repeats)
 
 
 def _peak_mib() -> float:
@@ -148,17 +171,18 @@ def bench_out(label, h, cluster_factory) -> dict:
 def _table(rows) -> str:
     lines = [
         (
-            "| case | backend | triangles | wall | CPU (this process) | speed-up (wall) | "
-            "RR mean | RR - serial |"
+            "| case | backend | triangles | rounds | wall (median) | CPU, this process "
+            "(median) | speed-up (wall, median) | speed-up range | RR mean | RR - serial |"
         ),
-        "|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         f = lambda v, fmt: "-" if v is None else fmt.format(v)
+        spread = "-" if r["range"] is None else "{:.2f}-{:.2f}x".format(*r["range"])
         lines.append(
-            f"| {r['case']} | {r['backend']} | {r['triangles']} | {r['wall']:.2f} s | "
-            f"{r['cpu']:.2f} s | {f(r['speedup'], '{:.2f}x')} | {f(r['rr'], '{:.4f}')} | "
-            f"{f(r['drr'], '{:+.4f}')} |"
+            f"| {r['case']} | {r['backend']} | {r['triangles']} | {r['rounds']} | "
+            f"{r['wall']:.2f} s | {r['cpu']:.2f} s | {f(r['speedup'], '{:.2f}x')} | {spread} | "
+            f"{f(r['rr'], '{:.4f}')} | {f(r['drr'], '{:+.4f}')} |"
         )
     return "\n".join(lines)
 
@@ -192,9 +216,9 @@ def main(quick: bool, out_dir: Path) -> int:
     mem = bench_out(*largest, cluster)  # first: the driver's peak is still its own
     rows = []
     with cluster() as client:
-        rows += bench_many(200 if quick else 1000, client)
+        rows += bench_many(200 if quick else 1000, client, QUICK_ROUNDS if quick else MANY_ROUNDS)
         for label, h in sizes.items():
-            rows += bench_square(label, h, client)
+            rows += bench_square(label, h, client, QUICK_ROUNDS if quick else SQUARE_ROUNDS)
     load.append(os.getloadavg()[0])
     text = [
         (

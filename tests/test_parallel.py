@@ -106,6 +106,24 @@ def test_dask_batches_of_domains_give_the_same_meshes(dask_client, serial_meshes
         assert_same(checked(mesh), ref)
 
 
+def test_dask_without_chunksize_sends_the_domains_in_batches_of_the_automatic_size(
+    dask_client, checked
+):
+    from distributed import get_task_stream
+
+    from aftmesh.parallel import auto_chunksize
+
+    domains = [box(i, 0, i + 1, 1 + 0.01 * i) for i in range(200)]
+    workers = dask_client.scheduler_info()["workers"].values()
+    chunk = auto_chunksize(len(domains), sum(w["nthreads"] for w in workers))
+    assert chunk > 1
+    with get_task_stream(dask_client) as stream:
+        out = aftmesh.generate_many(domains, 0.5, client=dask_client)
+    assert len(stream.data) == -(-len(domains) // chunk)
+    for i in (0, 77, 199):
+        assert_same(checked(out[i]), aftmesh.generate(domains[i], 0.5))
+
+
 @pytest.mark.parametrize("kind", BACKENDS, ids=["serial", "threads", "dask"])
 def test_more_domains_than_tasks_in_flight_all_come_back_in_order(kind, request, checked):
     # 2 workers keep at most 8 tasks in flight: 30 domains refill the window many times
