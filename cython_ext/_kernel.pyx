@@ -188,6 +188,53 @@ cdef inline void _release(void** array) noexcept:
     array[0] = NULL
 
 
+cdef int _insert_pslg(Tri* T, const int64_t* rounds, const int32_t* seg, int m,
+                      bint from_hull, int32_t* merged, int* n_merged, int* through,
+                      int* failed) noexcept nogil:
+    """Triangulation.insert_pslg's work on T's T.nv vertices (the segments' indices
+    checked by the caller): merged[i] the vertex input vertex i became; counts the
+    merged vertices, the segments split at vertices on them, and the segment that
+    failed (-1: none).  Returns the first error or >= 0."""
+    cdef int n = T.nv, i, res = 0
+    failed[0] = -1
+    for i in range(n):
+        merged[i] = i
+    res = brio_insert(T, T.xy, n, rounds, merged) if n else 0
+    for i in range(n):
+        n_merged[0] += merged[i] != i
+    for i in range(m):
+        if res < 0:
+            break
+        res = insert_segment(T, merged[seg[2 * i]], merged[seg[2 * i + 1]], E_SEGMENT, i)
+        if res < 0:
+            failed[0] = i
+        else:
+            through[0] += res
+    if res >= 0:
+        res = carve_domain(T, NULL, 0, from_hull)
+    return res
+
+
+cdef void _refine_setup(Refine* R, double min_angle, int n_corners, bint split_segments):
+    """A Refine for the minimum-angle pass at `min_angle` degrees (see refine.pxi)."""
+    cdef double c = math.cos(math.radians(min_angle))
+    memset(R, 0, sizeof(Refine))
+    R.c2_bad = c * c * (1.0 - REFINE_ANGLE_MARGIN)
+    R.c2_small = c * c * (1.0 + REFINE_ANGLE_MARGIN)
+    R.offcentre = OFFCENTRE_FACTOR * 0.5 * math.sqrt((1.0 + c) / (1.0 - c))
+    R.split_segments = split_segments
+    R.n_corner = n_corners
+
+
+cdef dict _refine_counts(Refine* R):
+    """Triangulation.refine's counts of a finished pass."""
+    return dict(inserted=R.inserted, segment_splits=R.splits, interior=R.interior,
+                dropped=R.dropped, excepted_triangles=R.excepted,
+                unresolved_triangles=R.unresolved, insertion_cap=R.max_insert,
+                stopped_by={STOP_NONE: None, STOP_MAX_TRIANGLES: "max_triangles",
+                            STOP_CAP: "insertion_cap"}[R.stop])
+
+
 cdef class Triangulation:
     """A triangulation of a point set with constrained edges, held in flat arrays.
 
@@ -265,22 +312,8 @@ cdef class Triangulation:
         merged_arr = np.empty(n, dtype=np.int32)
         cdef int32_t* merged = _i32v(merged_arr)
         with nogil:
-            for i in range(n):
-                merged[i] = i
-            res = brio_insert(T, T.xy, n, &rounds[0], merged) if n else 0
-            for i in range(n):
-                n_merged += merged[i] != i
-            for i in range(m):
-                if res < 0:
-                    break
-                res = insert_segment(T, merged[segments[i, 0]], merged[segments[i, 1]],
-                                     E_SEGMENT, i)
-                if res < 0:
-                    failed = i
-                else:
-                    through += res
-            if res >= 0:
-                res = carve_domain(T, NULL, 0, from_hull)
+            res = _insert_pslg(T, &rounds[0] if n else NULL, &segments[0, 0] if m else NULL,
+                               m, from_hull, merged, &n_merged, &through, &failed)
         try:
             _raise_for(T, res)
         except CrossingError as err:
@@ -756,13 +789,7 @@ cdef class Triangulation:
         set_options.  Returns a dict of counts."""
         cdef Refine R
         cdef int res
-        cdef double c = math.cos(math.radians(min_angle))
-        memset(&R, 0, sizeof(Refine))
-        R.c2_bad = c * c * (1.0 - REFINE_ANGLE_MARGIN)
-        R.c2_small = c * c * (1.0 + REFINE_ANGLE_MARGIN)
-        R.offcentre = OFFCENTRE_FACTOR * 0.5 * math.sqrt((1.0 + c) / (1.0 - c))
-        R.split_segments = split_segments
-        R.n_corner = n_corners
+        _refine_setup(&R, min_angle, n_corners, split_segments)
         self._note_thread()
         try:
             with nogil:
@@ -775,11 +802,7 @@ cdef class Triangulation:
             problems = self.validate()
             if problems:
                 raise KernelError("after refine: " + "; ".join(problems[:5]))
-        return dict(inserted=R.inserted, segment_splits=R.splits, interior=R.interior,
-                    dropped=R.dropped, excepted_triangles=R.excepted,
-                    unresolved_triangles=R.unresolved, insertion_cap=R.max_insert,
-                    stopped_by={STOP_NONE: None, STOP_MAX_TRIANGLES: "max_triangles",
-                                STOP_CAP: "insertion_cap"}[R.stop])
+        return _refine_counts(&R)
 
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,

@@ -12,9 +12,13 @@
 # runs them instead (from the start: nothing here has side effects).
 #
 # Uses: the kernel's def layer (background_field, size_field_count,
-# discretize_boundary, Triangulation) and inputs.pxi's checks.
+# discretize_boundary, Triangulation) and inputs.pxi's checks; past the boundary's
+# discretization, the C routines under Triangulation's methods directly (_insert_pslg,
+# domain.pxi, front.pxi, smoothing.pxi, refine.pxi), so that they run in one nogil
+# stretch.
 
 from libc.math cimport nextafter, pow, INFINITY, isfinite, fabs
+from posix.time cimport clock_gettime, timespec, CLOCK_MONOTONIC
 
 # The rules of sizing.py and _stages.py this call applies, by position in `rules`
 # (_stages.COMMON_RULES builds the array from the named constants there).
@@ -119,31 +123,168 @@ cdef double _smallest_size(const double[::1] u, const double[::1] g):
     return h
 
 
-cdef object _inside_exterior(Triangulation tri, const int32_t[::1] piece_edge,
-                             const int32_t[::1] edge_source):
+cdef int _inside_exterior(Tri* T, const int32_t* piece_edge,
+                          const int32_t* edge_source) noexcept nogil:
     """prepare_front's classification of one valid polygon's pieces (region 0 inside,
     -1 in a hole), without probing: the carve from the hull left only the inner side
     of each exterior-ring segment (source 0), and the inside of a valid polygon is
     connected, so it is the one piece those sides are in; every other piece lies
-    inside a hole.  (comp, region of each piece), or None when the sides are in
-    more than one piece (then the stages classify by probes)."""
-    cdef Tri* T = &tri.T
-    cdef int e, s, inside = -1
-    comp_arr, _probes, _corners = tri.components()
-    cdef int32_t[::1] comp = comp_arr
-    for e in range(3 * T.nt):
+    inside a hole.  Returns 1 when it set the regions, 0 when the sides are in more
+    than one piece (then the stages classify by probes), or an error."""
+    cdef int e, s, t, nc, inside = -1, res = 1
+    cdef int n = T.nt if T.nt > 0 else 1
+    cdef int32_t* comp = <int32_t*> malloc(n * sizeof(int32_t))
+    cdef int32_t* best = <int32_t*> malloc(n * sizeof(int32_t))
+    cdef int32_t* region = NULL
+    if comp == NULL or best == NULL:
+        free(comp)
+        free(best)
+        return ERR_NOMEM
+    for t in range(T.nt):
+        comp[t] = -1
+    nc = domain_components(T, comp, best)
+    if nc < 0:
+        res = nc
+    for e in range(3 * T.nt if res > 0 else 0):
         s = T.eseg[e]
         if (s < 0 or not T.eflag[e] & E_SEGMENT or T.tstate[e // 3] != T_UNMESHED
                 or edge_source[piece_edge[s]] != 0):
             continue
         if inside >= 0 and comp[e // 3] != inside:
-            return None
+            res = 0
+            break
         inside = comp[e // 3]
-    if inside < 0:
+    if res > 0 and inside < 0:
+        res = 0
+    if res > 0:
+        region = <int32_t*> malloc(nc * sizeof(int32_t))
+        if region == NULL:
+            res = ERR_NOMEM
+        else:
+            for t in range(nc):
+                region[t] = -1
+            region[inside] = 0
+            set_regions(T, comp, T.nt, region)
+    free(region)
+    free(comp)
+    free(best)
+    return res
+
+
+cdef double _clock() noexcept nogil:
+    """time.perf_counter() (CLOCK_MONOTONIC on Linux, in seconds), without the GIL."""
+    cdef timespec ts
+    clock_gettime(CLOCK_MONOTONIC, &ts)
+    return <double> (<int64_t> ts.tv_sec * 1000000000 + ts.tv_nsec) / 1e9
+
+
+# How _mesh_pieces ended
+cdef enum:
+    PIECES_RAN = 0            # to the end, or to the kernel error in Pieces.res
+    PIECES_DECLINED = 1       # the stages must run instead
+    PIECES_INSERT_FAILED = 2  # insert_pslg's error: a crossing or collinear one declines
+
+
+cdef struct Pieces:
+    # in: the boundary pieces and what to run on them
+    const int64_t* rounds
+    const int32_t* seg
+    int m
+    const int32_t* piece_edge   # NULL: no classification (no holes)
+    const int32_t* edge_source
+    long long max_triangles
+    int first_movable
+    int smooth_rounds
+    bint refining
+    # out
+    int res                     # the first kernel error, or >= 0
+    int n_merged, through, failed, moves
+    double t_cdt, t_aft
+
+
+cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noexcept nogil:
+    """The stages from the boundary CDT to the refined mesh without the GIL, in one
+    stretch: a thread meshing small domains then takes the GIL back once per domain,
+    not once per stage (each time it may have to wait for another thread's Python
+    work).  The checks between the stages are the stages' own (see generate_common)."""
+    cdef int i, n_unmeshed = 0
+    P.res = _insert_pslg(T, P.rounds, P.seg, P.m, True, merged, &P.n_merged, &P.through,
+                         &P.failed)
+    if P.res < 0:
+        return PIECES_INSERT_FAILED
+    if P.through:
+        return PIECES_DECLINED
+    if P.piece_edge != NULL:
+        P.res = _inside_exterior(T, P.piece_edge, P.edge_source)
+        if P.res <= 0:
+            return PIECES_DECLINED if P.res == 0 else PIECES_RAN
+    for i in range(T.nt):
+        n_unmeshed += T.tstate[i] == T_UNMESHED
+    if n_unmeshed == 0 or 0 <= P.max_triangles < n_unmeshed:
+        return PIECES_DECLINED
+    P.t_cdt = _clock()
+    P.res = convert_to_frontal_edge_set(A, T)
+    if P.res >= 0:
+        P.res = basic_aft_loop(A, T)
+    if P.res >= 0 and P.smooth_rounds:
+        P.res = smooth(A, T, P.first_movable, P.smooth_rounds)
+        P.moves = P.res
+    P.t_aft = _clock()
+    if P.res >= 0 and P.refining:
+        P.res = refine_mesh(R, A, T)
+    return PIECES_RAN
+
+
+cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
+                              const int32_t[:, ::1] seg, object piece_edge,
+                              const int32_t[::1] edge_source, long long max_triangles,
+                              int smooth_rounds, double min_angle, int n_corners):
+    """_mesh_pieces on tri (its size field and options set), with the def layer's
+    error handling: None where the stages must run, else (merged vertices, smoothing
+    moves, the refine pass's counts or None, t_cdt, t_aft)."""
+    cdef Pieces P
+    cdef Refine R
+    cdef int outcome, nv = tri.T.nv
+    cdef const int32_t[::1] pe
+    memset(&P, 0, sizeof(Pieces))
+    P.m = seg.shape[0]
+    P.rounds = &rounds[0] if nv else NULL
+    P.seg = &seg[0, 0] if P.m else NULL
+    if piece_edge is not None:
+        pe = piece_edge
+        P.piece_edge = &pe[0]
+        P.edge_source = &edge_source[0]
+    P.max_triangles = max_triangles
+    P.first_movable = nv
+    P.smooth_rounds = smooth_rounds
+    P.refining = min_angle != 0
+    memset(&R, 0, sizeof(Refine))
+    if P.refining:
+        _refine_setup(&R, min_angle, n_corners, True)
+    merged_arr = np.empty(nv, dtype=np.int32)
+    cdef int32_t* merged = _i32v(merged_arr)
+    tri.A.progress = NULL
+    tri._note_thread()
+    try:
+        with nogil:
+            outcome = _mesh_pieces(&tri.T, &tri.A, &R, merged, &P)
+    finally:
+        refine_free(&R)
+    if outcome == PIECES_INSERT_FAILED:
+        try:
+            _raise_for(&tri.T, P.res)
+        except (CrossingError, CollinearError):
+            return None
+    if outcome == PIECES_DECLINED:
         return None
-    region_arr = np.full(len(_probes), -1, dtype=np.int32)
-    region_arr[inside] = 0
-    return comp_arr, region_arr
+    _reraise_pending(&tri.A)
+    _raise_for(&tri.T, P.res)
+    if DEBUG:
+        problems = tri.validate()
+        if problems:
+            raise KernelError("after Basic_aft and refine: " + "; ".join(problems[:5]))
+    done = _refine_counts(&R) if P.refining else None
+    return P.n_merged, P.moves, done, P.t_cdt, P.t_aft
 
 
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
@@ -222,31 +363,17 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     if (coordinate_flags(_f64v(v_out), 2 * nv, EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
             or not _pieces_proper(_f64v(v_out), nv, _i32v(s_out), len(s_out))):
         return None
-    tri = Triangulation(v_out, <int> min(hint, <long long> rules[RULE_MAX_PREALLOCATED]))
-    try:
-        _, n_merged, through = tri.insert_pslg(rounds[:nv], s_out, True)
-    except (CrossingError, CollinearError):
-        return None
-    if through:
-        return None
-    if classify:
-        regions = _inside_exterior(tri, e_out, edge_source)
-        if regions is None:
-            return None
-        tri.set_regions(*regions)
-    _, n_unmeshed, _ = tri.state_counts()
-    if n_unmeshed == 0 or 0 <= max_triangles < n_unmeshed:
-        return None
     if min_area is None:
         min_area = rules[RULE_MIN_AREA_FACTOR] * pow(h_min, 2.0)
+    cdef Triangulation tri = Triangulation(
+        v_out, <int> min(hint, <long long> rules[RULE_MAX_PREALLOCATED]))
     tri.set_size_field(*args)
     tri.set_options(order=order, max_triangles=max_triangles, min_area=float(min_area),
                     close_factor=close_factor, swaps=swaps, greedy=greedy)
-    t_cdt = perf_counter()
-    tri.convert_to_frontal_edge_set()
-    tri.run()
-    moves = tri.smooth(nv, smooth_rounds) if smooth_rounds else 0
-    t_aft = perf_counter()
-    done = tri.refine(min_angle, n, True) if min_angle else None
+    out = _mesh_from_pieces(tri, rounds[:nv], s_out, e_out if classify else None,
+                            edge_source, max_triangles, smooth_rounds, min_angle, n)
+    if out is None:
+        return None
+    n_merged, moves, done, t_cdt, t_aft = out
     return (tri, e_out, nv, n_merged, field, expected, moves, done,
             (t_boundary, t_cdt, t_aft))

@@ -21,6 +21,7 @@ serially and ``info['partition_fallback']`` says why.
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import os
 import time
 from pathlib import Path
@@ -49,12 +50,30 @@ def _mesh_part(part: dict, field, options: dict) -> Mesh:
     return generate(part, field, split_boundary=False, **options)
 
 
+def _mesh_part_fields(part: dict, field, options: dict) -> dict:
+    """_mesh_part as a Dask task: the Mesh's fields as a dict, rebuilt by
+    Mesh._adopt in the driver.  A dict of arrays travels by Dask's own array
+    serializer; a Mesh falls back to pickle, which moved a 1e6-triangle mesh from a
+    LocalCluster worker in 0.17-0.29 s against 0.09-0.13 s for its fields."""
+    mesh = _mesh_part(part, field, options)
+    return {f.name: getattr(mesh, f.name) for f in dataclasses.fields(mesh)}
+
+
 def _run_parts(parts, field, options, client, workers):
     if client is not None:
+        from distributed import as_completed
+
         # the size field goes to each worker once, not with every part
         field = client.scatter(field, broadcast=True)
-        futures = client.map(_mesh_part, parts, field=field, options=options, pure=False)
-        return client.gather(futures)
+        futures = client.map(_mesh_part_fields, parts, field=field, options=options, pure=False)
+        # each part's mesh is fetched as soon as it is made, while the others are
+        # still meshing (one gather of all waits for the last part, then moves every
+        # part's arrays at once: about 2 s of 18 at 1e7 triangles on 2 workers)
+        slot = {future.key: i for i, future in enumerate(futures)}
+        meshes: list = [None] * len(futures)
+        for future in as_completed(futures, loop=client.loop):
+            meshes[slot[future.key]] = Mesh._adopt(**future.result())
+        return meshes
     workers = workers or min(len(parts), os.cpu_count() or 1)
     with cf.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="aftmesh-part") as pool:
         return list(pool.map(lambda part: _mesh_part(part, field, options), parts))
