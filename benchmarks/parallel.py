@@ -8,7 +8,9 @@
   the largest process against the size of the whole mesh's arrays.
 
 Each case runs its backends in turn, several rounds; the speed-ups are the medians,
-with their range, of the ratios within a round.  Wall time and the CPU time of this
+with their range, of the ratios within a round.  The threads run against serial runs
+while no Dask cluster exists, as a user of threads has none; the Dask backends then
+run against serial runs of their own beside the cluster ("serial, cluster up").  Wall time and the CPU time of this
 process (Dask workers' CPU is not in it) are printed as a Markdown table and written
 to ``benchmarks/out/parallel.md``, with the load average at the start and the end.
 """
@@ -104,25 +106,47 @@ def _rounds(case: str, backends: dict, repeats: int) -> list:
     return rows
 
 
-def bench_many(n, client, repeats: int) -> list:
+def _with_and_without(case: str, serial, threads: dict, dask: dict, cluster, repeats) -> list:
+    """The thread backends against serial runs while no Dask cluster exists (an idle
+    2-worker LocalCluster, its scheduler in this process, took about 17 % of a core
+    on this machine: that comes out of a 2-thread run, not out of a serial one); then
+    a cluster of `cluster()` and the Dask backends (`dask`: a backend for a client)
+    against serial runs beside it."""
+    rows = _rounds(case, {"serial": serial, **threads}, repeats)
+    with cluster() as client:
+        on_dask = {name: make(client) for name, make in dask.items()}
+        dask_rows = _rounds(case, {"serial": serial, **on_dask}, repeats)
+    dask_rows[0]["backend"] = "serial, cluster up"
+    return rows + dask_rows
+
+
+def bench_many(n, cluster, repeats: int) -> list:
     doms = small_polygons(n)
-    backends = {
-        "serial": lambda: [aftmesh.generate(d, SMALL_SIZE) for d in doms],
-        "2 threads": lambda: aftmesh.generate_many(doms, SMALL_SIZE, workers=2),
+    return _with_and_without(
+        f"{n} polygons",
+        lambda: [aftmesh.generate(d, SMALL_SIZE) for d in doms],
+        {"2 threads": lambda: aftmesh.generate_many(doms, SMALL_SIZE, workers=2)},
         # the automatic batches, as a user gets them
-        "Dask 2 procs": lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=client),
-    }
-    return _rounds(f"{n} polygons", backends, repeats)
+        {"Dask 2 procs": lambda c: lambda: aftmesh.generate_many(doms, SMALL_SIZE, client=c)},
+        cluster,
+        repeats,
+    )
 
 
-def bench_square(label, h, client, repeats: int) -> list:
+def bench_square(label, h, cluster, repeats: int) -> list:
     d = box(0, 0, 1, 1)
-    backends = {
-        "serial": lambda: aftmesh.generate(d, h),
-        "partitions=2, 2 threads": lambda: aftmesh.generate(d, h, partitions=2),
-        "partitions=2, Dask 2 procs": lambda: aftmesh.generate(d, h, partitions=2, client=client),
-    }
-    return _rounds(f"square ~{label}", backends, repeats)
+    return _with_and_without(
+        f"square ~{label}",
+        lambda: aftmesh.generate(d, h),
+        {"partitions=2, 2 threads": lambda: aftmesh.generate(d, h, partitions=2)},
+        {
+            "partitions=2, Dask 2 procs": lambda c: (
+                lambda: aftmesh.generate(d, h, partitions=2, client=c)
+            )
+        },
+        cluster,
+        repeats,
+    )
 
 
 def _peak_mib() -> float:
@@ -214,11 +238,10 @@ def main(quick: bool, out_dir: Path) -> int:
     load = [os.getloadavg()[0]]
     largest = list(sizes.items())[-1]
     mem = bench_out(*largest, cluster)  # first: the driver's peak is still its own
-    rows = []
-    with cluster() as client:
-        rows += bench_many(200 if quick else 1000, client, QUICK_ROUNDS if quick else MANY_ROUNDS)
-        for label, h in sizes.items():
-            rows += bench_square(label, h, client, QUICK_ROUNDS if quick else SQUARE_ROUNDS)
+    rounds = QUICK_ROUNDS if quick else MANY_ROUNDS
+    rows = bench_many(200 if quick else 1000, cluster, rounds)
+    for label, h in sizes.items():
+        rows += bench_square(label, h, cluster, QUICK_ROUNDS if quick else SQUARE_ROUNDS)
     load.append(os.getloadavg()[0])
     text = [
         (

@@ -67,8 +67,8 @@ def _run_parts(parts, field, options, client, workers):
         field = client.scatter(field, broadcast=True)
         futures = client.map(_mesh_part_fields, parts, field=field, options=options, pure=False)
         # each part's mesh is fetched as soon as it is made, while the others are
-        # still meshing (one gather of all waits for the last part, then moves every
-        # part's arrays at once: about 2 s of 18 at 1e7 triangles on 2 workers)
+        # still meshing (one gather of all waits for the last part before it moves
+        # any part's arrays)
         slot = {future.key: i for i, future in enumerate(futures)}
         meshes: list = [None] * len(futures)
         for future in as_completed(futures, loop=client.loop):
