@@ -91,6 +91,12 @@ def parse_args(argv):
         "a 2-worker Dask LocalCluster (needs distributed)",
     )
     p.add_argument(
+        "--overhead",
+        action="store_true",
+        help="the fixed cost of one generate call on a 100-vertex polygon (see "
+        "python -m benchmarks.overhead for its options and the small-and-real group)",
+    )
+    p.add_argument(
         "--gmsh-limit",
         type=float,
         default=None,
@@ -137,6 +143,11 @@ def _main(argv) -> int:
         print("realworld:", " ".join(REALWORLD_CASES))
         for k, (_label, desc) in MESHERS.items():
             print(f"mesher:  {k:14s} {desc}")
+        return 0
+    if args.overhead:
+        from . import overhead
+
+        overhead.run_overhead(overhead.OVERHEAD_CALLS)
         return 0
     if args.parallel:
         from . import parallel
