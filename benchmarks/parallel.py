@@ -10,9 +10,10 @@
 Each case runs its backends in turn, several rounds; the speed-ups are the medians,
 with their range, of the ratios within a round.  The threads run against serial runs
 while no Dask cluster exists, as a user of threads has none; the Dask backends then
-run against serial runs of their own beside the cluster ("serial, cluster up").  Wall time and the CPU time of this
-process (Dask workers' CPU is not in it) are printed as a Markdown table and written
-to ``benchmarks/out/parallel.md``, with the load average at the start and the end.
+run against serial runs of their own beside the cluster ("serial, cluster up").
+Wall time and the CPU time of this process (Dask workers' CPU is not in it) are
+printed as a Markdown table and written to ``benchmarks/out/parallel.md``, with the
+load average at the start and the end.
 """
 
 from __future__ import annotations
