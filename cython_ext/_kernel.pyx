@@ -116,25 +116,9 @@ cdef object _raise_for(Tri* T, int code):
     raise KernelError(f"aftmesh kernel: internal invariant broken (code {code})")
 
 
-# Raw data pointers of C-contiguous numpy arrays for the kernel routines (NULL when
-# empty: the routines then never read them).
-cdef int32_t* _i32(arr) except? NULL:
-    cdef int32_t[::1] v = arr.reshape(-1)
-    return &v[0] if v.shape[0] else NULL
-
-
-cdef uint8_t* _u8(arr) except? NULL:
-    cdef uint8_t[::1] v = arr.reshape(-1)
-    return &v[0] if v.shape[0] else NULL
-
-
-cdef double* _f64(arr) except? NULL:
-    cdef double[::1] v = arr.reshape(-1)
-    return &v[0] if v.shape[0] else NULL
-
-
-# The same for arrays known to be fresh, C-contiguous and of that dtype (the
-# kernel's own outputs): the buffer is read without reshaping first.
+# Raw data pointers of arrays known to be C-contiguous and of that dtype (the
+# kernel's own outputs, or arrays made so by the caller); NULL when empty, where the
+# routines never read them.
 cdef void* _buffer_of(object arr) except? NULL:
     cdef Py_buffer view
     cdef void* out
@@ -346,6 +330,20 @@ cdef class Triangulation:
         indices, counter-clockwise; nb (t, 3), the triangle across the edge opposite
         vertex k, -1 at the hull)."""
         return _finite_arrays(&self.T)
+
+    def edge_keys(self, int64_t n):
+        """The edges of finite_triangles' triangles, each once, as the sorted int64
+        keys a n + b (a < b; n must exceed every vertex index)."""
+        cdef int64_t m
+        if n < self.T.nv:
+            raise ValueError(f"edge keys need n >= {self.T.nv} (the vertex count), got {n}")
+        keys_arr = np.empty(3 * max(self.T.nt, 1), dtype=np.int64)
+        cdef int64_t[::1] keys = keys_arr
+        with nogil:
+            m = finite_edge_keys(&self.T, n, &keys[0])
+        keys_arr = keys_arr[:m]
+        keys_arr.sort()
+        return keys_arr
 
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
                         int first_id=0):

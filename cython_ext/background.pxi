@@ -40,6 +40,27 @@ cdef void finite_into(Tri* T, const int32_t* index, int32_t* tv, int32_t* nb) no
                 nb[3 * index[t] + k] = index[T.twin[3 * t + (k + 1) % 3] // 3]
 
 
+cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys) noexcept nogil:
+    """keys[i] = a n + b (a < b) for each edge a-b of the live finite triangles, once
+    (keys holds 3 T.nt); returns how many.  Unsorted: in half-edge order."""
+    cdef int t, k, e, te
+    cdef int64_t a, b, m = 0
+    for t in range(T.nt):
+        if T.tstate[t] == T_FREE or is_ghost(T, t):
+            continue
+        for k in range(3):
+            e = 3 * t + k
+            te = T.twin[e]
+            # an edge shared by two finite triangles is listed from its larger half-edge
+            if te > e and T.tstate[te // 3] != T_FREE and not is_ghost(T, te // 3):
+                continue
+            a = T.tv[e]
+            b = T.tv[nxt(e)]
+            keys[m] = a * n + b if a < b else b * n + a
+            m += 1
+    return m
+
+
 cdef int unused_to_inf(int n, int nt, const int32_t* tv, double* g) noexcept nogil:
     """g[v] = inf at the points in no triangle (merged into an equal one, never read);
     returns 1 when g is finite at all the others, else 0 (or ERR_NOMEM)."""

@@ -221,6 +221,23 @@ def test_background_field_is_the_triangulation_and_gradation_it_replaces(n):
     assert finite == bool(np.isfinite(want_g[used]).all())
 
 
+@pytest.mark.parametrize("n", [3, 10, 300])
+def test_edge_keys_are_the_unique_sorted_edges_of_the_finite_triangles(n):
+    # the size field's sampling rounds (sizing._resolve_callable) take their edges here
+    rng = np.random.default_rng(n)
+    xy = rng.integers(0, 12, size=(n, 2)).astype(np.float64)  # repeats: merged points
+    xy[:3] = [[-1.0, -1.0], [13.0, -1.0], [6.0, 13.0]]
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(_order.brio_order(xy))
+    tv, _nb = tri.finite_triangles()
+    e = np.sort(np.concatenate([tv[:, [0, 1]], tv[:, [1, 2]], tv[:, [2, 0]]]), axis=1)
+    big = n + 7
+    want = np.unique(e[:, 0].astype(np.int64) * big + e[:, 1])
+    assert (tri.edge_keys(big) == want).all()
+    with pytest.raises(ValueError, match="vertex count"):
+        tri.edge_keys(n - 1)
+
+
 def _pslg_by_steps(xy, seg, from_hull):
     tri = _kernel.Triangulation(xy)
     merged = tri.insert_points(_order.brio_order(xy))

@@ -259,12 +259,12 @@ def _box_corners(bounds) -> np.ndarray:
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
 
 
-def _edge_keys(tv: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """The background's edges, each once: (keys, (e, 2) vertex pairs)."""
-    e = np.concatenate([tv[:, [0, 1]], tv[:, [1, 2]], tv[:, [2, 0]]]).astype(np.int64)
-    e.sort(axis=1)
-    keys, first = np.unique(e[:, 0] * n + e[:, 1], return_index=True)
-    return keys, e[first]
+def _not_in(keys: np.ndarray, passed: np.ndarray) -> np.ndarray:
+    """Which of the sorted keys are not in the sorted array passed."""
+    if len(passed) == 0:
+        return np.ones(len(keys), dtype=bool)
+    at = np.minimum(np.searchsorted(passed, keys), len(passed) - 1)
+    return passed[at] != keys
 
 
 def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
@@ -273,16 +273,15 @@ def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
     misses it (RESOLVE_TOLERANCE) while longer than the size there (RESOLVE_SPAN), or
     where they are longer than RESOLVE_COARSEST sizes.  An edge that passed once is
     not sampled again while it lasts."""
-    passed = np.zeros(0, dtype=np.int64)
+    passed = np.zeros(0, dtype=np.int64)  # sorted edge keys
     calls = 0
     n_max = len(pts) + RESOLVE_EVALUATIONS
     for _ in range(RESOLVE_ROUNDS):
-        tv, _nb = tri.finite_triangles()
-        keys, edges = _edge_keys(tv, n_max)
-        todo = ~np.isin(keys, passed, assume_unique=True)
-        keys, edges = keys[todo], edges[todo]
+        keys = tri.edge_keys(n_max)
+        keys = keys[_not_in(keys, passed)]
         if len(keys) == 0 or calls + len(keys) > RESOLVE_EVALUATIONS:
             break
+        edges = np.column_stack([keys // n_max, keys % n_max])
         a, b = pts[edges[:, 0]], pts[edges[:, 1]]
         mid = 0.5 * (a + b)
         um = _evaluate(size, mid[:, 0], mid[:, 1])
@@ -291,7 +290,7 @@ def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
         length = np.linalg.norm(b - a, axis=1)
         miss = np.abs(0.5 * (u[edges[:, 0]] + u[edges[:, 1]]) - um) > RESOLVE_TOLERANCE * um
         bad = (miss & (length > RESOLVE_SPAN * um)) | (length > RESOLVE_COARSEST * um)
-        passed = np.concatenate([passed, keys[~bad]])
+        passed = np.sort(np.concatenate([passed, keys[~bad]]))
         if not bad.any():
             break
         new = mid[bad]
