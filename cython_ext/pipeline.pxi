@@ -67,6 +67,15 @@ cdef bint _pieces_proper(const double* xy, Py_ssize_t n, const int32_t* seg,
     return True
 
 
+cdef object _round_keys_of(object round_keys, Py_ssize_t n):
+    """round_keys(n) (_order.round_keys: the stages order the same points by the same
+    keys), checked to be n keys."""
+    keys = round_keys(n)
+    if len(keys) != n:
+        raise ValueError(f"round_keys({n}) returned {len(keys)} keys")
+    return keys
+
+
 cdef object _common_field(const double[:, ::1] v, const double* box, double res,
                           double constant, double gradation, const double* short,
                           const double[::1] rules, object rounds):
@@ -81,8 +90,6 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
             c_min = short[i]
     if c_min >= rules[RULE_CONSTANT_IF_EDGES_ABOVE] * constant:
         return None
-    if nb4 > len(rounds):
-        return False
     pts_arr = np.empty((nb4, 2), dtype=np.float64)
     u_arr = np.full(nb4, constant)
     g_arr = np.empty(nb4, dtype=np.float64)
@@ -106,7 +113,8 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     for i in range(nb4):
         length = (short[i] if short[i] >= floor else floor) if i < n else INFINITY
         g[i] = (constant if constant <= length else length) if gradation > 1.0 else length
-    tv, nb, finite = background_field(pts_arr, rounds[:nb4], g_arr, spread - 1.0)
+    tv, nb, finite = background_field(pts_arr, _round_keys_of(rounds, nb4), g_arr,
+                                      spread - 1.0)
     if not finite:
         return False
     return pts_arr, u_arr, g_arr, tv, nb, spread - 1.0, rules[RULE_BOUNDARY_REACH]
@@ -297,8 +305,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     """The stages of generate from the size field to the refined mesh, for a number
     size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
-    the exterior ring source 0.  rounds: _order.round_keys of as many points
-    as it holds; max_pieces: the most boundary pieces allowed; progress_limit: the
+    the exterior ring source 0.  rounds: _order.round_keys, called for the BRIO
+    round keys of the background's and the boundary's points; max_pieces: the most boundary pieces allowed; progress_limit: the
     triangle hint above which a progress bar may be wanted; min_angle 0: no pass.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
@@ -358,7 +366,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     hint_f = expected + 4 * nv
     hint = <long long> (hint_f if hint_f < rules[RULE_MAX_TRIANGLE_HINT]
                         else rules[RULE_MAX_TRIANGLE_HINT])
-    if hint > progress_limit or nv > len(rounds):
+    if hint > progress_limit:
         return None
     if (coordinate_flags(_f64v(v_out), 2 * nv, EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
             or not _pieces_proper(_f64v(v_out), nv, _i32v(s_out), len(s_out))):
@@ -370,8 +378,9 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     tri.set_size_field(*args)
     tri.set_options(order=order, max_triangles=max_triangles, min_area=float(min_area),
                     close_factor=close_factor, swaps=swaps, greedy=greedy)
-    out = _mesh_from_pieces(tri, rounds[:nv], s_out, e_out if classify else None,
-                            edge_source, max_triangles, smooth_rounds, min_angle, n)
+    out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
+                            e_out if classify else None, edge_source, max_triangles,
+                            smooth_rounds, min_angle, n)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

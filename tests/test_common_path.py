@@ -147,6 +147,47 @@ def test_common_case_declines_what_only_the_stages_report(monkeypatch):
     assert taken.declined == 3 and taken.taken == 0
 
 
+def test_common_case_takes_boundaries_longer_than_the_cached_round_keys(monkeypatch, checked):
+    # more boundary points than _order.CACHED_ROUNDS, in the background and after the
+    # discretization: the compiled call draws the longer keys the stages draw
+    from aftmesh._order import CACHED_ROUNDS
+
+    n = CACHED_ROUNDS + 500
+    t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    ring = np.c_[np.cos(t), np.sin(t) * (1.0 + 0.02 * np.cos(7.0 * t))]
+    edge = float(np.min(np.hypot(*(np.roll(ring, -1, axis=0) - ring).T)))
+    assert _compare(monkeypatch, Polygon(ring), 4.0 * edge, checked).taken == 1
+
+
+def test_common_case_declines_a_large_mesh_only_where_a_progress_bar_may_show(
+    monkeypatch, checked
+):
+    import aftmesh._stages as stages
+
+    class Terminal:
+        def isatty(self):
+            return True
+
+        def write(self, s):
+            pass
+
+        def flush(self):
+            pass
+
+    monkeypatch.setattr(stages, "PROGRESS_MIN_TRIANGLES", 50)  # "large" from 50 on
+    # standard error not a terminal (captured): no bar is possible, the call is taken
+    assert _compare(monkeypatch, box(0, 0, 1, 1), 0.05, checked).taken == 1
+    terminal = Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    taken = Taken(monkeypatch)
+    checked(aftmesh.generate(box(0, 0, 1, 1), 0.05))
+    assert taken.declined == 1 and taken.taken == 0  # the stages may draw the bar
+    assert isinstance(stages._progress_callback(None, 51), stages._ProgressBar)
+    taken = Taken(monkeypatch)
+    checked(aftmesh.generate(box(0, 0, 1, 1), 0.05, progress=False))
+    assert taken.taken == 1
+
+
 def test_common_case_takes_only_plain_numbers(monkeypatch):
     taken = _compare(monkeypatch, box(0, 0, 1, 1), np.float64(0.25))
     assert taken.taken == 0

@@ -12,6 +12,7 @@ declines, and generate runs the stages instead.
 from __future__ import annotations
 
 import math
+import sys
 import time
 
 import numpy as np
@@ -19,7 +20,7 @@ from shapely.geometry import Polygon
 
 from . import _stages
 from ._kernel import COMMON_RULE_COUNT, generate_common
-from ._order import CACHED_ROUNDS, round_keys
+from ._order import round_keys
 from .boundary import MAX_SAMPLES
 from .domain_record import Domain
 from .mesh import Mesh
@@ -94,6 +95,19 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
     )
 
 
+def _progress_limit(progress) -> float:
+    """The triangle hint above which the stages might draw a progress bar (the
+    compiled call declines there): none when progress is False, or None with standard
+    error not a terminal (the rule of _stages._progress_callback)."""
+    if progress is False:
+        return math.inf
+    try:
+        terminal = sys.stderr.isatty()  # one system call, about a microsecond
+    except (AttributeError, ValueError, OSError):
+        terminal = True  # no usable stderr: the stages decide, as they always have
+    return _stages.PROGRESS_MIN_TRIANGLES if terminal else math.inf
+
+
 def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> Mesh | None:
     """The Mesh of generate by the compiled call, or None where it declines (then
     nothing has changed, and the stages run).  The caller checked `applies`."""
@@ -108,10 +122,10 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         float(size),
         float(opts.gradation),
         float(dom.area or 0.0),
-        round_keys(CACHED_ROUNDS),
+        round_keys,
         _RULES,
         float(3 * cap),  # boundary_cdt's bound on the pieces
-        np.inf if opts.progress is False else _stages.PROGRESS_MIN_TRIANGLES,
+        _progress_limit(opts.progress),
         int(ORDERS[opts.order]),
         -1 if opts.max_triangles is None else opts.max_triangles,
         opts.min_area,
