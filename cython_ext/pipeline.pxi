@@ -306,8 +306,9 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
     the exterior ring source 0.  rounds: _order.round_keys, called for the BRIO
-    round keys of the background's and the boundary's points; max_pieces: the most boundary pieces allowed; progress_limit: the
-    triangle hint above which a progress bar may be wanted; min_angle 0: no pass.
+    round keys of the background's and the boundary's points; max_pieces: the most
+    boundary pieces allowed; progress_limit: the triangle hint above which a progress
+    bar may be wanted; min_angle 0: no pass.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's

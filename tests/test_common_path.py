@@ -159,9 +159,7 @@ def test_common_case_takes_boundaries_longer_than_the_cached_round_keys(monkeypa
     assert _compare(monkeypatch, Polygon(ring), 4.0 * edge, checked).taken == 1
 
 
-def test_common_case_declines_a_large_mesh_only_where_a_progress_bar_may_show(
-    monkeypatch, checked
-):
+def test_common_case_declines_a_large_mesh_only_where_a_progress_bar_may_show(monkeypatch, checked):
     import aftmesh._stages as stages
 
     class Terminal:
