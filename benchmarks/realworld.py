@@ -194,6 +194,9 @@ def _run(args) -> dict:
     meshers = args.meshers or GROUP_MESHERS
     limit = args.gmsh_limit if args.gmsh_limit is not None else 3e5
     print(f"real-world group: {len(names)} cases x {len(meshers)} meshers")
+    # before any availability check: it puts src/ on this process's path when the
+    # kernel is built in place there, as the workers get it
+    print(f"aftmesh: {runner.locate_aftmesh()}")
     return runner.run_mesh_suite(
         names, meshers, quick=True, repeat=min(args.repeat, 3), gmsh_limit=limit
     )
