@@ -1138,13 +1138,23 @@ def vertices_near_segments_pairs(const double[:, ::1] xy, const int64_t[:, ::1] 
     return out[:, 0], out[:, 1]
 
 
-def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg):
-    """The length of the shortest segment at each point (inf at a point on none)."""
+def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg,
+                   bint kept_whole=False):
+    """The length of the shortest segment at each point (inf at a point on none).
+    kept_whole: the size each point asks for when the segments are not split (see
+    kept_edge_sizes_into: the geometric mean where two meet at a wide angle)."""
     cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0]
     _check_pslg(xy, seg)
     out_arr = np.empty(n, dtype=np.float64)
     cdef double[::1] out = out_arr
-    if n:
+    cdef double[::1] longest
+    cdef int32_t[::1] ends
+    if n and kept_whole:
+        longest = np.empty(n, dtype=np.float64)
+        ends = np.empty(3 * n, dtype=np.int32)
+        kept_edge_sizes_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0],
+                             &longest[0], &ends[0])
+    elif n:
         shortest_edges_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0])
     return out_arr
 

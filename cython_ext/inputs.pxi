@@ -241,6 +241,59 @@ cdef void shortest_edges_into(const double* xy, Py_ssize_t n, const int32_t* seg
             out[b] = d
 
 
+# With input edges kept whole (split_boundary=False) a long edge cannot be cut down to
+# its short neighbour's size, so at a vertex joining the two the shortest edge's length
+# asked the long edge's own triangle to sit in a field far finer than itself: its apex
+# was pulled onto the fine layers (flat triangles along the long edge) inside rings of
+# graded ones.  Where two edges meet wider than this, the vertex asks for the geometric
+# mean of their lengths instead, each edge then off by the square root of their ratio;
+# in a sharper corner the triangles are bounded by the short edge whatever is asked.
+# (Real-world group kept whole: mean radius ratio 0.9430 -> 0.9445, a sixth fewer
+# triangles; with edges split, the shortest stays better: 0.9626 against 0.9604.)
+cdef double KEPT_MEAN_MIN_COS = 0.5    # cos 60 degrees
+
+
+cdef void kept_edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* seg,
+                               Py_ssize_t m, double* out, double* longest,
+                               int32_t* ends) noexcept nogil:
+    """out[v] = the size input vertex v asks for when its edges are kept whole: the
+    shortest segment at v, but the geometric mean of the two where exactly two meet at
+    an angle wider than KEPT_MEAN_MIN_COS says (inf at a point on none).  longest (n)
+    and ends (3 n: the count of segments at v, then the far ends of the first two) are
+    scratch."""
+    cdef Py_ssize_t k, v
+    cdef int32_t a, b, c
+    cdef double d, ux, uy, wx, wy, lu, lw
+    shortest_edges_into(xy, n, seg, m, out)
+    for v in range(n):
+        longest[v] = 0.0
+        ends[3 * v] = 0
+    for k in range(2 * m):
+        a = seg[k]
+        b = seg[k ^ 1]
+        d = sqrt((xy[2 * b] - xy[2 * a]) * (xy[2 * b] - xy[2 * a])
+                 + (xy[2 * b + 1] - xy[2 * a + 1]) * (xy[2 * b + 1] - xy[2 * a + 1]))
+        if d > longest[a]:
+            longest[a] = d
+        c = ends[3 * a]
+        if c < 2:
+            ends[3 * a + 1 + c] = b
+        ends[3 * a] = c + 1
+    for v in range(n):
+        if ends[3 * v] != 2 or not out[v] > 0.0:
+            continue
+        a = ends[3 * v + 1]
+        b = ends[3 * v + 2]
+        ux = xy[2 * a] - xy[2 * v]
+        uy = xy[2 * a + 1] - xy[2 * v + 1]
+        wx = xy[2 * b] - xy[2 * v]
+        wy = xy[2 * b + 1] - xy[2 * v + 1]
+        lu = sqrt(ux * ux + uy * uy)
+        lw = sqrt(wx * wx + wy * wy)
+        if ux * wx + uy * wy < KEPT_MEAN_MIN_COS * lu * lw:
+            out[v] = sqrt(out[v]) * sqrt(longest[v])
+
+
 cdef int take_into(const int32_t* table, Py_ssize_t n, const int32_t* index, Py_ssize_t m,
                    int32_t* out) noexcept nogil:
     """out[i] = table[index[i]], -1 where index[i] is -1 (the kernel's and the domain's

@@ -188,6 +188,24 @@ def test_shortest_edges_is_the_numpy_minimum(pairs):
     assert _kernel.shortest_edges(xy, seg).tobytes() == want.tobytes()
 
 
+@given(st.lists(st.tuples(st.integers(0, 5), st.integers(0, 5)), max_size=10))
+def test_kept_whole_sizes_are_the_geometric_mean_at_wide_two_edge_vertices(pairs):
+    rng = np.random.default_rng(len(pairs))
+    xy = rng.normal(size=(6, 2))
+    seg = np.array(pairs, dtype=np.int32).reshape(-1, 2)
+    want = _kernel.shortest_edges(xy, seg)
+    ends = [[int(b) for a, b in np.concatenate([seg, seg[:, ::-1]]) if a == v] for v in range(6)]
+    for v, far in enumerate(ends):
+        if len(far) != 2 or not want[v] > 0:
+            continue
+        u, w = xy[far[0]] - xy[v], xy[far[1]] - xy[v]
+        lu, lw = np.linalg.norm(u), np.linalg.norm(w)
+        if u @ w < 0.5 * lu * lw:  # wider than 60 degrees
+            want[v] = np.sqrt(want[v]) * np.sqrt(max(lu, lw))
+    got = _kernel.shortest_edges(xy, seg, kept_whole=True)
+    np.testing.assert_allclose(got, want, rtol=1e-14)
+
+
 @pytest.mark.parametrize("n", [0, 1, 2, 9, 200, 5000])
 def test_brio_keys_order_is_the_stable_numpy_argsort(n):
     rng = np.random.default_rng(n)

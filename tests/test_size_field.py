@@ -50,6 +50,22 @@ def test_short_edge_gets_its_own_size_and_good_angles(cut, checked):
     assert len(mesh.triangles) < len(plain.triangles) + RINGS_PER_E_FOLD * np.log(0.05 / cut)
 
 
+def test_kept_whole_edges_ask_the_geometric_mean_where_they_meet_wide(checked):
+    """split_boundary=False keeps a long edge whole beside a short one, so a vertex
+    joining them at a wide angle asks for the geometric mean of the two lengths (the
+    shortest drew graded rings around every short edge and flattened the long edge's
+    triangle onto them); when edges may be split, the vertex asks for its shortest
+    edge (sharp corners: test_input_kernels)."""
+    ring = [(0, 0), (1, 0), (1.01, 0), (2.01, 0), (2.01, 0.3), (0, 0.3)]
+    poly = Polygon(ring)
+    kept = checked(aftmesh.generate(poly, 0.5, split_boundary=False), domain_area=poly.area)
+    split = checked(aftmesh.generate(poly, 0.5), domain_area=poly.area)
+    for end in ((1, 0), (1.01, 0)):  # edges 1 and 0.01 in a straight line
+        assert kept.info["size_field"](*end) == pytest.approx(0.1, rel=1e-12)
+        assert split.info["size_field"](*end) == pytest.approx(0.01, rel=1e-12)
+    assert len(kept.triangles) < len(split.triangles)
+
+
 def test_field_cost_follows_the_input_not_the_bounding_box():
     """A long thin domain with one short edge: the field holds the input's vertices
     and the box's four corners, nothing proportional to the box's area."""

@@ -91,11 +91,16 @@ def expected_triangles(field: SizeField, area: float, gradation: float) -> float
     return float(total * min(1.0, area / max(covered, 1e-300)) * ESTIMATE_MARGIN)
 
 
-def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
+def size_field(
+    dom: Domain, size, gradation: float, kept_whole: bool = False
+) -> tuple[SizeField, float]:
     """The size field over the domain, and the number of triangles it asks for.
 
     The user's size is combined with the shortest input edge at each vertex: the size
-    never asks for more than that edge there."""
+    never asks for more than that edge there.  With the input edges kept whole
+    (``kept_whole``, split_boundary=False), a vertex where two edges meet at a wide
+    angle asks for the geometric mean of their lengths instead (the kernel's
+    ``shortest_edges`` says why)."""
     if isinstance(size, np.ndarray) and size.ndim == 0:
         size = size.item()
     lo, hi = bounding_box(np.ascontiguousarray(dom.vertices, dtype=np.float64))
@@ -106,7 +111,7 @@ def size_field(dom: Domain, size, gradation: float) -> tuple[SizeField, float]:
     seg = dom.segments
     if len(seg):
         verts = np.ascontiguousarray(dom.vertices, dtype=np.float64)
-        shortest = shortest_edges(verts, np.ascontiguousarray(seg, dtype=np.int32))
+        shortest = shortest_edges(verts, np.ascontiguousarray(seg, dtype=np.int32), kept_whole)
         used = np.isfinite(shortest)
         if not used.all():  # a lone point: no edge there
             verts, shortest = verts[used], shortest[used]

@@ -156,7 +156,9 @@ def generate(
         input edges.
     split_boundary : bool
         Split input edges according to the size (default) or keep them exactly as
-        given (the paper's assumption).
+        given (the paper's assumption).  Kept whole, a vertex where two input edges
+        meet at more than 60 degrees asks for the geometric mean of their lengths
+        rather than the shorter one: the longer edge cannot be split to match it.
     gradation : float
         Bound on how fast the size may grow, per unit of its own length (>= 1).
     close_factor : float
@@ -282,7 +284,7 @@ def generate(
         mesh = _common.common_case(dom, size, opts, edge_tags, t_start)
         if mesh is not None:
             return mesh
-    field, expected = _stages.size_field(dom, size, opts.gradation)
+    field, expected = _stages.size_field(dom, size, opts.gradation, not opts.split_boundary)
     t_boundary = time.perf_counter()
     boundary = _stages.boundary_cdt(dom, field, opts, expected)
     kernel = _stages.prepare_front(boundary, dom, field, opts)

@@ -6,7 +6,8 @@ and y are 1-D arrays of equal length, the result one size per point or a scalar)
 ``None`` (sizes taken from the lengths of the boundary's own edges and spread inward).
 
 Whatever it is, it is combined with what the boundary asks for (an input edge shorter
-than the size keeps its length as the size at its ends) and gradation-limited, so that
+than the size keeps its length as the size at its ends; with split_boundary=False, where
+two edges meet at a wide angle, the geometric mean of theirs) and gradation-limited, so that
 the size never grows faster than ``gradation`` per unit of length relative to itself
 (h(x) <= h(y) + (gradation - 1) |x - y|).  The result is a constant, or sizes at the
 vertices of a background Delaunay triangulation of the input vertices (plus the points
