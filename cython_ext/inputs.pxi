@@ -221,6 +221,13 @@ cdef int rings_are_proper(const double* xy, Py_ssize_t n, const int64_t* seg,
     return 1
 
 
+cdef inline double segment_length(const double* xy, int32_t a, int32_t b) noexcept nogil:
+    """|xy[b] - xy[a]|, rounded as np.linalg.norm(..., axis=1) rounds it (hypot may
+    differ by an ulp), and the same from either end (a difference only changes sign)."""
+    return sqrt((xy[2 * b] - xy[2 * a]) * (xy[2 * b] - xy[2 * a])
+                + (xy[2 * b + 1] - xy[2 * a + 1]) * (xy[2 * b + 1] - xy[2 * a + 1]))
+
+
 cdef void shortest_edges_into(const double* xy, Py_ssize_t n, const int32_t* seg,
                               Py_ssize_t m, double* out) noexcept nogil:
     """out[v] = the length of the shortest segment at vertex v, inf if none."""
@@ -232,9 +239,7 @@ cdef void shortest_edges_into(const double* xy, Py_ssize_t n, const int32_t* seg
     for k in range(m):
         a = seg[2 * k]
         b = seg[2 * k + 1]
-        # as np.linalg.norm(..., axis=1) rounds it (hypot may differ by an ulp)
-        d = sqrt((xy[2 * b] - xy[2 * a]) * (xy[2 * b] - xy[2 * a])
-                 + (xy[2 * b + 1] - xy[2 * a + 1]) * (xy[2 * b + 1] - xy[2 * a + 1]))
+        d = segment_length(xy, a, b)
         if d < out[a]:
             out[a] = d
         if d < out[b]:
@@ -268,11 +273,10 @@ cdef void kept_edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* se
         out[v] = INFINITY
         longest[v] = 0.0
         ends[3 * v] = 0
-    for k in range(2 * m):       # each segment from both ends, rounded as shortest_edges_into
+    for k in range(2 * m):       # each segment from both ends
         a = seg[k]
         b = seg[k ^ 1]
-        d = sqrt((xy[2 * b] - xy[2 * a]) * (xy[2 * b] - xy[2 * a])
-                 + (xy[2 * b + 1] - xy[2 * a + 1]) * (xy[2 * b + 1] - xy[2 * a + 1]))
+        d = segment_length(xy, a, b)
         if d < out[a]:
             out[a] = d
         if d > longest[a]:
