@@ -703,6 +703,14 @@ def _arrays(draw):
         return np.array(vals, dtype=object).reshape(shape)
 
 
+def _nan_polygon() -> Polygon:
+    """A polygon with a NaN coordinate, made quietly: shapely warns on the NaN while
+    building it, and the warning is about the test's input, not about aftmesh."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return Polygon([(0, 0), (1, 0), (np.nan, 1)])
+
+
 _SENTINELS = st.sampled_from(
     [
         object(),
@@ -711,7 +719,7 @@ _SENTINELS = st.sampled_from(
         Point(0, 0),
         LineString([(0, 0), (1, 1)]),
         GeometryCollection(),
-        Polygon([(0, 0), (1, 0), (np.nan, 1)]),
+        _nan_polygon(),
         MultiPolygon(),
         range(3),
         b"\x00\x01",
