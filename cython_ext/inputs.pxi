@@ -268,7 +268,7 @@ cdef void kept_edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* se
     scratch."""
     cdef Py_ssize_t k, v
     cdef int32_t a, b, c
-    cdef double d, ux, uy, wx, wy, lu, lw
+    cdef double d, ux, uy, wx, wy
     for v in range(n):
         out[v] = INFINITY
         longest[v] = 0.0
@@ -294,9 +294,8 @@ cdef void kept_edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* se
         uy = xy[2 * a + 1] - xy[2 * v + 1]
         wx = xy[2 * b] - xy[2 * v]
         wy = xy[2 * b + 1] - xy[2 * v + 1]
-        lu = sqrt(ux * ux + uy * uy)
-        lw = sqrt(wx * wx + wy * wy)
-        if ux * wx + uy * wy < KEPT_MEAN_MIN_COS * lu * lw:
+        # with two segments at v, the shortest and longest are their two lengths
+        if ux * wx + uy * wy < KEPT_MEAN_MIN_COS * out[v] * longest[v]:
             out[v] = sqrt(out[v]) * sqrt(longest[v])
 
 
