@@ -167,29 +167,22 @@ def summary_table(sec: dict) -> str:
             missing.append(cname)
         cols = zip(*[c or ["err"] * 6 for c in cells])
         out.append(f"| {cname} | " + " | ".join(" / ".join(col) for col in cols) + " |")
-    avg = []
-    for m in meshers:
-        st = [by[(c, m)]["stats"] for c in common]
-        avg.append(
-            [
-                np.mean([s[k] for s in st]) if st else np.nan
-                for k in ("rr_mean", "rr_above_0.9", "min_angle", "triangles")
-            ]
-            + [np.mean([bad_triangles(s) for s in st]) if st else np.nan]
-        )
-    out.append(
-        f"| **average ({len(common)} cases)** | "
-        + " / ".join(f"{a[0]:.4f}" for a in avg)
-        + " | "
-        + " / ".join(f"{100 * a[1]:.1f}" for a in avg)
-        + " | "
-        + " / ".join(f"{a[4]:.0f}" for a in avg)
-        + " | "
-        + " / ".join(f"{a[2]:.1f}" for a in avg)
-        + " | "
-        + " / ".join(f"{a[3]:.0f}" for a in avg)
-        + " | - |"
+    # (stat of each case, how the column's average is written), in the table's order
+    columns = (
+        (lambda s: s["rr_mean"], "{:.4f}"),
+        (lambda s: 100 * s["rr_above_0.9"], "{:.1f}"),
+        (bad_triangles, "{:.0f}"),
+        (lambda s: s["min_angle"], "{:.1f}"),
+        (lambda s: s["triangles"], "{:.0f}"),
     )
+    cells = []
+    for stat, fmt in columns:
+        means = []
+        for m in meshers:
+            st = [by[(c, m)]["stats"] for c in common]
+            means.append(fmt.format(np.mean([stat(s) for s in st]) if st else np.nan))
+        cells.append(" / ".join(means))
+    out.append(f"| **average ({len(common)} cases)** | " + " | ".join(cells) + " | - |")
     if missing:
         out.append("")
         out.append(f"Left out of the averages (a mesher failed): {', '.join(missing)}.")
