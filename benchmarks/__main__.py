@@ -150,6 +150,9 @@ def _main(argv) -> int:
         overhead.run_overhead(overhead.OVERHEAD_CALLS)
         return 0
     if args.parallel:
+        from . import runner
+
+        runner.import_located()  # before parallel imports aftmesh
         from . import parallel
 
         return parallel.main(args.quick, args.out)

@@ -28,6 +28,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from . import runner
+
 # Calls timed per round, and rounds (the minimum is printed: the least disturbed).
 CALLS = 600
 ROUNDS = 3
@@ -160,7 +162,7 @@ def main(argv=None) -> None:
         return
     with tempfile.TemporaryDirectory() as tmp:
         lib = _build_shim(Path(tmp))
-        env = dict(os.environ, LD_PRELOAD=str(lib), **{_ENV: "1"})
+        env = dict(runner.worker_env(), LD_PRELOAD=str(lib), **{_ENV: "1"})
         args_given = sys.argv[1:] if argv is None else list(argv)
         cmd = [sys.executable, "-m", "benchmarks.gil", *args_given]
         subprocess.run(cmd, env=env, check=True)

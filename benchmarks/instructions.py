@@ -106,7 +106,7 @@ def parse_annotate(text: str) -> dict[str, int]:
 
 def _count(name: str, calls: int) -> tuple[dict[str, int], int]:
     """One callgrind run of the child: (its counts, the triangles of the mesh)."""
-    env = runner._env()  # the aftmesh the benchmark workers import
+    env = runner.worker_env()  # the aftmesh the benchmark workers import
     env.update(OMP_NUM_THREADS="1", PYTHONHASHSEED="0")
     child = _CHILD.format(root=str(runner.ROOT), name=name, calls=calls)
     with tempfile.TemporaryDirectory() as tmp:

@@ -13,6 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
+from . import runner
 from .cases import build_case
 
 COLOURS = {
@@ -25,12 +26,12 @@ COLOURS = {
 OUT = Path(__file__).resolve().parent / "out"
 
 
-def diagnose_case(name: str, threshold: float):
+def diagnose_case(name: str, threshold: float, split: bool = False):
     from aftmesh.diagnose import diagnose
 
     case = build_case(name)
     return diagnose(
-        case.as_triangle_dict(), case.size_arg, threshold=threshold, split_boundary=False
+        case.as_triangle_dict(), case.size_arg, threshold=threshold, split_boundary=split
     )
 
 
@@ -80,17 +81,25 @@ def main(argv=None) -> int:
         type=Path,
         help="picture path (one case), default benchmarks/out/quality_<case>.png",
     )
+    p.add_argument(
+        "--split",
+        action="store_true",
+        help="mesh as generate's default does, input segments split (the aft-split "
+        "mesher); without it they are kept whole (aft)",
+    )
     args = p.parse_args(sys.argv[1:] if argv is None else argv)
+    print(f"aftmesh: {runner.locate_aftmesh()}")
     OUT.mkdir(parents=True, exist_ok=True)
     total: dict[str, int] = {}
     for name in args.cases:
-        diag = diagnose_case(name, args.threshold)
+        diag = diagnose_case(name, args.threshold, args.split)
         print(f"{name}:")
         print(diag.summary())
         for c, k in diag.counts.items():
             total[c] = total.get(c, 0) + k
-        path = args.png if args.png and len(args.cases) == 1 else OUT / f"quality_{name}.png"
-        draw(diag, f"{name}: RR < {args.threshold:g} by cause", path)
+        mode = "-split" if args.split else ""
+        path = args.png if args.png and len(args.cases) == 1 else OUT / f"quality_{name}{mode}.png"
+        draw(diag, f"{name}{mode}: RR < {args.threshold:g} by cause", path)
         print(f"  picture: {path}")
     if len(args.cases) > 1:
         n = max(sum(total.values()), 1)

@@ -76,9 +76,22 @@ def locate_aftmesh() -> str:
     return _AFTMESH["file"]
 
 
-def _env() -> dict:
+def worker_env() -> dict:
+    """The environment of a worker process: it imports the aftmesh `locate_aftmesh`
+    chose."""
     locate_aftmesh()
     return _env_with(list(_AFTMESH["parts"]))
+
+
+def import_located() -> str:
+    """For a benchmark that imports aftmesh in this process and starts processes of
+    its own (Dask workers, a memory probe): `locate_aftmesh`, and the same aftmesh
+    for those children too, through this process's PYTHONPATH."""
+    where = locate_aftmesh()
+    if not _AFTMESH.get("exported"):
+        os.environ["PYTHONPATH"] = worker_env()["PYTHONPATH"]
+        _AFTMESH["exported"] = True
+    return where
 
 
 def _import_failed(err: str) -> bool:
@@ -94,7 +107,7 @@ def run_job(job: dict, timeout: float) -> dict:
             proc = subprocess.run(
                 [sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
                 cwd=ROOT,
-                env=_env(),
+                env=worker_env(),
                 capture_output=True,
                 text=True,
                 timeout=timeout,
