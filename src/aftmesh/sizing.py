@@ -67,7 +67,7 @@ RESOLVE_COARSEST = 8
 # (lengths in one octave) closer than about this fraction of it become one point.  Next
 # to a dense boundary the background's long edges come in fans, whose midpoints lie
 # side by side: inserted all, they cost a graded airfoil 5,388 background points and
-# 16,773 evaluations (the cap stopped it); thinned, 1,034 and 7,073, with the same
+# 16,773 evaluations (the cap stopped it); thinned, 1,019 and 7,002, with the same
 # mesh quality.  An edge left out is not passed: the next round samples it again.
 RESOLVE_THIN = 0.5
 # Sampling rounds (each one batched call of the callable) and evaluations in all: the
