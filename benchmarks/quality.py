@@ -1,4 +1,5 @@
-"""``python -m benchmarks.quality CASE [CASE ...] [--threshold 0.9] [--png out.png]``
+"""``python -m benchmarks.quality CASE [CASE ...] [--threshold 0.9] [--png out.png] [--split]``
+or ``python -m benchmarks.quality --bands CASE [CASE ...] [--mesher NAME ...]``
 
 Labels each triangle of aftmesh's mesh of a benchmark case whose radius ratio is below
 the threshold by where it came from (:func:`aftmesh.diagnose.diagnose`: smoothing,
@@ -6,7 +7,7 @@ boundary, size transition, front collision, other), prints the counts per class 
 draws the bad triangles coloured by class.  CASE is any benchmark case name (see
 ``python -m benchmarks --list``), including the real-world group's ``rw-*``.
 
-``--bands`` also compares meshers band by band of distance from the input edges (in
+``--bands`` instead compares meshers band by band of distance from the input edges (in
 target sizes): triangles, mean radius ratio, the count at or below the threshold, the
 radius-ratio deficit sum(1 - RR), and the share of the triangles' corners that are
 points the mesher added inside with six neighbours (a mesh's lattice regularity).
@@ -60,11 +61,11 @@ def band_rows(name: str, mesher: str, threshold: float) -> list[dict]:
     from .meshers import prepare
 
     case = build_case(name)
-    runner = prepare(mesher, case)
+    job = prepare(mesher, case)
     try:
-        out = runner.result(runner.run())
+        out = job.result(job.run())
     finally:
-        runner.close()
+        job.close()
     pts, tris = np.asarray(out.points), np.asarray(out.triangles, dtype=np.int64)
     rr = triangle_quality(pts, tris)["radius_ratio"]
     cent = pts[tris].mean(axis=1)
@@ -107,10 +108,10 @@ def _six_neighbours(tris: np.ndarray, pts: np.ndarray, inputs: np.ndarray) -> np
     key, count = np.unique(e[:, 0] * n_points + e[:, 1], return_counts=True)
     a, b = key // n_points, key % n_points
     neighbours = np.bincount(a, minlength=n_points) + np.bincount(b, minlength=n_points)
-    on_hull = np.zeros(n_points, dtype=bool)
-    on_hull[a[count == 1]] = on_hull[b[count == 1]] = True
+    on_boundary = np.zeros(n_points, dtype=bool)  # at an edge of one triangle
+    on_boundary[a[count == 1]] = on_boundary[b[count == 1]] = True
     given = np.isin(pts[:, 0] + 1j * pts[:, 1], inputs[:, 0] + 1j * inputs[:, 1])
-    return ((neighbours == 6) & ~on_hull & ~given).astype(float)
+    return ((neighbours == 6) & ~on_boundary & ~given).astype(float)
 
 
 def print_bands(name: str, meshers, threshold: float) -> None:
