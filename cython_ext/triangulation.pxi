@@ -202,6 +202,11 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     Before: t0 = (a, b, c) with e = a->b, t1 = (b, a, d) with twin f = b->a.
     After:  t0 = (c, a, d) and t1 = (d, b, c); the new diagonal is c-d (3*t0+2 / 3*t1+2).
     The caller has checked that the quadrilateral a, d, b, c is strictly convex.
+
+    Writes only what a flip changes (it is the commonest rewrite: tens per inserted
+    vertex in a large unmeshed region).  The four outer edges keep their flags and
+    segment ids, which already sit on both twins; each triangle keeps its state and
+    region; vhe ends as set_tri of (c, a, d) then (d, b, c) would leave it.
     """
     cdef int t0 = e // 3
     cdef int f = T.twin[e]
@@ -211,10 +216,45 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
     cdef int32_t ie1 = T.eseg[e1], ie2 = T.eseg[e2], if1 = T.eseg[f1], if2 = T.eseg[f2]
-    cdef uint8_t s0 = T.tstate[t0], s1 = T.tstate[t1]
-    cdef int32_t r0 = T.tregion[t0], r1 = T.tregion[t1]
-    set_tri(T, t0, c, a, d, te2, tf1, NONE, ge2, gf1, 0, ie2, if1, -1, s0, r0)
-    set_tri(T, t1, d, b, c, tf2, te1, 3 * t0 + 2, gf2, ge1, 0, if2, ie1, -1, s1, r1)
+    cdef int g0 = 3 * t0, g1 = 3 * t1
+    # t0 = (c, a, d): c->a was e2, a->d was f1, d->c the new diagonal
+    T.tv[g0] = c
+    T.tv[g0 + 1] = a
+    T.tv[g0 + 2] = d
+    # t1 = (d, b, c): d->b was f2, b->c was e1, c->d the new diagonal
+    T.tv[g1] = d
+    T.tv[g1 + 1] = b
+    T.tv[g1 + 2] = c
+    T.twin[g0] = te2
+    T.twin[te2] = g0
+    T.twin[g0 + 1] = tf1
+    T.twin[tf1] = g0 + 1
+    T.twin[g1] = tf2
+    T.twin[tf2] = g1
+    T.twin[g1 + 1] = te1
+    T.twin[te1] = g1 + 1
+    T.twin[g0 + 2] = g1 + 2
+    T.twin[g1 + 2] = g0 + 2
+    T.eflag[g0] = ge2
+    T.eflag[g0 + 1] = gf1
+    T.eflag[g0 + 2] = 0
+    T.eflag[g1] = gf2
+    T.eflag[g1 + 1] = ge1
+    T.eflag[g1 + 2] = 0
+    T.eseg[g0] = ie2
+    T.eseg[g0 + 1] = if1
+    T.eseg[g0 + 2] = -1
+    T.eseg[g1] = if2
+    T.eseg[g1 + 1] = ie1
+    T.eseg[g1 + 2] = -1
+    if a >= 0:
+        T.vhe[a] = g0 + 1
+    if b >= 0:
+        T.vhe[b] = g1 + 1
+    if c >= 0:
+        T.vhe[c] = g1 + 2
+    if d >= 0:
+        T.vhe[d] = g1
 
 
 cdef inline int in_circle_ext(Tri* T, int a, int b, int c, int d) noexcept nogil:
