@@ -205,22 +205,24 @@ def scaling_tables(sc: dict) -> list[str]:
     out = []
     hdr = (
         "| h | mesher | triangles | time (median) | CPU (median) | runs | tri/s | "
-        "peak mem (MiB) | bytes / triangle |"
+        "peak mem (MiB) | bytes / triangle | CPU / aftmesh.cdt of own output |"
     )
     out += [hdr, _rule(hdr)]
     for r in sc["rows"]:
         label = _label(r["mesher"])
         if "median" not in r:
             out.append(
-                f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 6
+                f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 7
             )
             continue
         n = r["triangles"]
+        own = r.get("own_cdt_cpu_median")
         out.append(
             f"| {r['h']:g} | {label} | {n} | {_t(r['median'])} | "
             f"{_t(r.get('cpu_median'))} | {len(r['times'])} | "
             f"{_rate(n / r['median'])} | {r['mem_mib']:.1f} | "
-            f"{r['mem_mib'] * 1048576 / n:.0f} |"
+            f"{r['mem_mib'] * 1048576 / n:.0f} | "
+            f"{_f(r['cpu_median'] / own if own else None, '{:.2f}')} |"
         )
     out.append("")
     for m, fit in sc["fits"].items():

@@ -320,6 +320,7 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
                 "min_repeat": 1,
                 "budget": 1.0 if quick else 20.0,
                 "edges": False,
+                "own_cdt": mname == "aft",
             }
             res = run_job(job, timeout=300 if quick else 1800)
             row = {"h": h, "mesher": mname, **res}
@@ -327,6 +328,8 @@ def run_scaling(*, quick: bool, repeat: int, log=print) -> dict:
                 row["median"] = _median(res["times"])
                 row["cpu_median"] = _median(res["cpu"])
                 row["triangles"] = res["stats"]["triangles"]
+                if "own_cdt" in res:
+                    row["own_cdt_cpu_median"] = _median(res["own_cdt"]["cpu"])
                 log(
                     f"  h={h:<8g} {mname:10s} {row['triangles']:>9d} tri  {row['median']:.4f} s"
                     f"  {res['mem_mib']:.0f} MiB"

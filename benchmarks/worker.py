@@ -2,7 +2,8 @@
 
 Prints one line ``@@RESULT <json>`` at the end.  Jobs:
 
-* ``{"kind": "mesh", "case", "mesher", "repeat", "min_repeat", "budget", "edges"}``
+* ``{"kind": "mesh", "case", "mesher", "repeat", "min_repeat", "budget", "edges"}``,
+  with ``"own_cdt": true`` (aftmesh) also timing ``aftmesh.cdt`` of its own output
 * ``{"kind": "cdt-speed", "sizes", "repeat", "constrained", "tools"}``
 * ``{"kind": "cdt-mem", "tool", "n"}``
 """
@@ -70,11 +71,12 @@ def mesh_job(job: dict) -> dict:
         cpu.append(time.process_time() - c0)
         timings.append(_internal_timing(raw))
         del raw
+    own = own_cdt_times(runner.run(), len(times)) if job.get("own_cdt") else None
     runner.close()
     internal = None
     if all(timings):
         internal = {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
-    return {
+    result = {
         "times": times,
         "cpu": cpu,
         "mem_mib": mem,
@@ -83,6 +85,28 @@ def mesh_job(job: dict) -> dict:
         "passes": passes,
         "internal_timing": internal,
     }
+    if own is not None:
+        result["own_cdt"] = own
+    return result
+
+
+def own_cdt_times(mesh, repeat: int) -> dict:
+    """Wall and CPU times of ``aftmesh.cdt`` of a generate call's own output: its
+    vertices and boundary segments, the least any mesher of that mesh must do."""
+    import aftmesh
+
+    points = np.ascontiguousarray(mesh.points)
+    segments = np.ascontiguousarray(mesh.segments)
+    del mesh
+    times, cpu = [], []
+    for _ in range(repeat):
+        gc.collect()
+        c0 = time.process_time()
+        t0 = time.perf_counter()
+        aftmesh.cdt(points, segments)
+        times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return {"times": times, "cpu": cpu}
 
 
 def _internal_timing(raw):
