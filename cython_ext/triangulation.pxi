@@ -226,13 +226,19 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     T.tv[g1 + 1] = b
     T.tv[g1 + 2] = c
     T.twin[g0] = te2
-    T.twin[te2] = g0
     T.twin[g0 + 1] = tf1
-    T.twin[tf1] = g0 + 1
     T.twin[g1] = tf2
-    T.twin[tf2] = g1
     T.twin[g1 + 1] = te1
-    T.twin[te1] = g1 + 1
+    # the outer twins link back; a NONE one (none in a finished triangulation) is
+    # skipped, as set_tri does, rather than written through
+    if te2 >= 0:
+        T.twin[te2] = g0
+    if tf1 >= 0:
+        T.twin[tf1] = g0 + 1
+    if tf2 >= 0:
+        T.twin[tf2] = g1
+    if te1 >= 0:
+        T.twin[te1] = g1 + 1
     T.twin[g0 + 2] = g1 + 2
     T.twin[g1 + 2] = g0 + 2
     T.eflag[g0] = ge2
