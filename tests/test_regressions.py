@@ -227,6 +227,7 @@ def test_ctrl_c_during_smoothing_interrupts(time_limit):
 
         _stages.smooth = smooth_with_signal
         try:
+            # a progress callable keeps generate on the stages, which call _stages.smooth
             aftmesh.generate(SQ, 0.002, smooth=1000, progress=lambda f: None)
         except KeyboardInterrupt:
             return "interrupted", (time.perf_counter() - state["sent"], state.get("in_smoothing"))
