@@ -691,6 +691,20 @@ cdef inline int _pred_orient2d_filter(const double* a, const double* b,
     return _pred_undecided
 
 
+cdef inline bint surely_acute(const double* a, const double* b,
+                              const double* p) noexcept nogil:
+    """True only if the angle at p of the triangle (a, b, p) is certainly below 90
+    degrees: (a - p).(b - p) > 0 exactly.  The dot product has the form of orient2d's
+    determinant (two products of differences from one point, added instead of
+    subtracted), so orient2d's filter bound holds for it, over the same exact range
+    of coordinates (see test_predicates.py); False when unsure.  (Two
+    such angles facing an edge sum to less than 180 degrees, so the edge is strictly
+    locally Delaunay: no incircle test is needed.)"""
+    cdef double xx = (a[0] - p[0]) * (b[0] - p[0])
+    cdef double yy = (a[1] - p[1]) * (b[1] - p[1])
+    return xx + yy > _pred_orient2d_errbound() * (fabs(xx) + fabs(yy))
+
+
 cdef inline int _pred_incircle_filter(const double* a, const double* b, const double* c,
                                       const double* d) noexcept nogil:
     cdef double adx = a[0] - d[0]
@@ -787,6 +801,14 @@ def _pred_py_incircle_stages(double ax, double ay, double bx, double by, double 
     cdef int f = _pred_incircle_filter(&p[0], &p[2], &p[4], &p[6])
     cdef int e = _pred_incircle_exact(&p[0], &p[2], &p[4], &p[6])
     return (None if f == _pred_undecided else f), e
+
+
+def _pred_py_surely_acute(double ax, double ay, double bx, double by, double px,
+                          double py):
+    """surely_acute(a, b, p): True only if the angle at p of (a, b, p) is acute."""
+    cdef double q[6]
+    q[:] = [ax, ay, bx, by, px, py]
+    return bool(surely_acute(&q[0], &q[2], &q[4]))
 
 
 def _pred_error_bounds():

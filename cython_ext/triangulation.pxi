@@ -2,7 +2,7 @@
 # Conventions: halfedge.pxd.  Geometry is only ever read through the predicates.
 #
 # Uses: halfedge.pxd (Tri, enums, nxt/prv, P, is_ghost, blocking); predicates.pxi
-# (orient2d, incircle).
+# (orient2d, incircle, surely_acute).
 from halfedge cimport *
 from libc.stdlib cimport malloc, realloc, free
 from libc.string cimport memset
@@ -307,6 +307,29 @@ cdef int lawson_after_insert(Tri* T, int nstack) noexcept nogil:
     return 0
 
 
+cdef inline bint illegal_meshed_edge(Tri* T, int e) noexcept nogil:
+    """legalize_meshed's test: e is an unconstrained edge between two meshed triangles
+    and the far apex is strictly inside the circumcircle of e's triangle.  Most
+    meshed triangles are acute, and when both angles facing e are surely acute the
+    far apex is strictly outside, as incircle would find: its test is skipped."""
+    cdef int f = T.twin[e]
+    cdef double* pa
+    cdef double* pb
+    cdef double* pc
+    cdef double* pd
+    if T.tstate[e // 3] != T_MESHED or T.tstate[f // 3] != T_MESHED:
+        return False
+    if T.eflag[e] & (E_SEGMENT | E_FIXED):
+        return False
+    pa = P(T, T.tv[e])
+    pb = P(T, T.tv[nxt(e)])
+    pc = P(T, T.tv[prv(e)])
+    pd = P(T, T.tv[prv(f)])
+    if surely_acute(pa, pb, pc) and surely_acute(pb, pa, pd):
+        return False
+    return incircle(pa, pb, pc, pd) > 0
+
+
 cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
     """Lawson flips inside the meshed region (Add_triangle): flip every unconstrained
     edge between two meshed triangles whose far apex is inside the circumcircle, until
@@ -315,15 +338,10 @@ cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
     while nstack > 0:
         nstack -= 1
         e = T.stack[nstack]
-        f = T.twin[e]
-        t0 = e // 3
-        t1 = f // 3
-        if T.tstate[t0] != T_MESHED or T.tstate[t1] != T_MESHED:
-            continue
-        if T.eflag[e] & (E_SEGMENT | E_FIXED):
-            continue
-        if incircle(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)]),
-                    P(T, T.tv[prv(f)])) > 0:
+        if illegal_meshed_edge(T, e):
+            f = T.twin[e]
+            t0 = e // 3
+            t1 = f // 3
             if T.vdirty != NULL:
                 T.vdirty[T.tv[e]] = 1
                 T.vdirty[T.tv[nxt(e)]] = 1

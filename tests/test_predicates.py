@@ -929,3 +929,142 @@ def test_stage_b_sign_readers_examples():
     assert _kernel._pred_py_sum_sign([1.0, 1e-16, -1.0], 2)[0] == 1
     assert _kernel._pred_py_sum_sign([0.0, 0.0], 1)[0] == 0
     assert _kernel._pred_py_sum_sign([2.0**-1000, -(2.0**-1000)], 1)[0] == 0
+
+
+# ---------------------------------------------------------------------------
+# surely_acute: the certificate that lets legalize_meshed skip incircle
+# ---------------------------------------------------------------------------
+
+
+def dot_oracle(a, b, p):
+    """Exact sign of (a - p).(b - p): > 0 when the angle at p is acute."""
+    (ax, ay), (bx, by), (px, py) = [(Fraction(x), Fraction(y)) for x, y in (a, b, p)]
+    return sign((ax - px) * (bx - px) + (ay - py) * (by - py))
+
+
+def check_acute(a, b, p):
+    """surely_acute may abstain (False) but never certifies an angle that is not
+    acute, in either order of a and b."""
+    got = _kernel._pred_py_surely_acute(*flat((a, b, p)))
+    assert got == _kernel._pred_py_surely_acute(*flat((b, a, p)))
+    if got:
+        assert dot_oracle(a, b, p) > 0, (a, b, p)
+    return got
+
+
+@st.composite
+def near_right_angle(draw, coord):
+    """p rounded onto the circle with diameter ab (Thales: a right angle at p),
+    then moved a few ulps."""
+    a = draw(coord)
+    b = draw(coord)
+    theta = draw(st.floats(min_value=0.0, max_value=2 * math.pi))
+    mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
+    r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
+    p = (nudge(mx + r * math.cos(theta), draw(ulps)), nudge(my + r * math.sin(theta), draw(ulps)))
+    return a, b, p
+
+
+@PROFILE
+@given(points_of(coords(ORIENT_EXP)), points_of(coords(ORIENT_EXP)), points_of(coords(ORIENT_EXP)))
+def test_surely_acute_random_full_range(a, b, p):
+    check_acute(a, b, p)
+
+
+@PROFILE
+@given(near_right_angle(points_of(moderate)))
+def test_surely_acute_near_right_angles(abp):
+    check_acute(*abp)
+
+
+@PROFILE
+@given(near_right_angle(points_of(st.floats(min_value=-1.0, max_value=1.0))))
+def test_surely_acute_near_right_angles_unit(abp):
+    check_acute(*abp)
+
+
+# Seeded near-right angles in the unit square: enough that plain floating point gets
+# the sign of some dot products wrong (the sweep asserts it does), so a certificate
+# without its error bound would be caught.
+THALES_SWEEP = 20000
+
+
+def test_surely_acute_never_certifies_what_rounding_gets_wrong():
+    rng = random.Random(20261203)
+    rounding_wrong = 0
+    for _ in range(THALES_SWEEP):
+        a = (rng.uniform(-1, 1), rng.uniform(-1, 1))
+        b = (rng.uniform(-1, 1), rng.uniform(-1, 1))
+        theta = rng.uniform(0, 2 * math.pi)
+        mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
+        r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
+        p = (
+            nudge(mx + r * math.cos(theta), rng.randint(-3, 3)),
+            nudge(my + r * math.sin(theta), rng.randint(-3, 3)),
+        )
+        exact = dot_oracle(a, b, p)
+        plain = (a[0] - p[0]) * (b[0] - p[0]) + (a[1] - p[1]) * (b[1] - p[1])
+        rounding_wrong += (plain > 0) != (exact > 0)
+        assert not check_acute(a, b, p) or exact > 0
+    assert rounding_wrong > 0
+
+
+@PROFILE
+@given(near_right_angle(near_1e7_point()))
+def test_surely_acute_near_right_angles_near_1e7(abp):
+    check_acute(*abp)
+
+
+@PROFILE
+@given(lattice_point(), lattice_point(), lattice_point())
+def test_surely_acute_tiny_lattice(a, b, p):
+    check_acute(a, b, p)
+
+
+@st.composite
+def thales_quad(draw, coord):
+    """a, b and two points rounded onto the circle with diameter ab, one on each side
+    (two angles of about 90 degrees facing ab, and four nearly cocircular points)."""
+    a, b, c = draw(near_right_angle(coord))
+    theta = draw(st.floats(min_value=0.0, max_value=2 * math.pi))
+    mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
+    r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
+    d = (nudge(mx + r * math.cos(theta), draw(ulps)), nudge(my + r * math.sin(theta), draw(ulps)))
+    return a, b, c, d
+
+
+def check_edge_certificate(a, b, c, d):
+    """legalize_meshed skips incircle(a, b, c, d) when the angles at c and d facing
+    the edge ab (c left of a->b, d right of it) are both surely acute: d must then
+    be strictly outside the circle through a, b, c."""
+    if orient_oracle(a, b, c) > 0 and orient_oracle(a, b, d) < 0:
+        if check_acute(a, b, c) and check_acute(b, a, d):
+            assert incircle_oracle(a, b, c, d) < 0, (a, b, c, d)
+
+
+@PROFILE
+@given(thales_quad(points_of(moderate)))
+def test_two_surely_acute_angles_make_an_edge_locally_delaunay(pts):
+    check_edge_certificate(*pts)
+
+
+@PROFILE
+@given(near_cocircular(moderate, st.floats(min_value=2.0**-20, max_value=2.0**20)))
+def test_two_surely_acute_angles_nearly_cocircular(pts):
+    check_edge_certificate(*pts)
+
+
+@PROFILE
+@given(st.lists(points_of(st.floats(min_value=-1.0, max_value=1.0)), min_size=4, max_size=4))
+def test_two_surely_acute_angles_random_quads(pts):
+    check_edge_certificate(*pts)
+
+
+def test_surely_acute_decides_clear_cases():
+    # an equilateral triangle's angles are certified; a right angle, an obtuse one and
+    # a degenerate triangle's never are
+    h = math.sqrt(3) / 2
+    assert check_acute((0.0, 0.0), (1.0, 0.0), (0.5, h))
+    assert not check_acute((0.0, 0.0), (2.0, 0.0), (1.0, 1.0))
+    assert not check_acute((0.0, 0.0), (2.0, 0.0), (1.0, 0.5))
+    assert not check_acute((0.0, 0.0), (1.0, 0.0), (0.0, 0.0))
