@@ -57,6 +57,9 @@ def mesh_job(job: dict) -> dict:
     stats["segments_out"] = out.n_segments
     stats["segments_in"] = int(len(case.segments))
     passes = runner.passes
+    # the first run's vertices and boundary, kept (copied, so that the rest of the
+    # mesh is freed before the timed runs) for the own-output CDT below
+    own_input = _own_cdt_input(raw) if job.get("own_cdt") else None
     del raw, out
     started = time.perf_counter()
     while len(times) < job["repeat"]:
@@ -71,7 +74,7 @@ def mesh_job(job: dict) -> dict:
         cpu.append(time.process_time() - c0)
         timings.append(_internal_timing(raw))
         del raw
-    own = own_cdt_times(runner.run(), len(times)) if job.get("own_cdt") else None
+    own = own_cdt_times(*own_input, len(times)) if own_input is not None else None
     runner.close()
     internal = None
     if all(timings):
@@ -90,14 +93,17 @@ def mesh_job(job: dict) -> dict:
     return result
 
 
-def own_cdt_times(mesh, repeat: int) -> dict:
-    """Wall and CPU times of ``aftmesh.cdt`` of a generate call's own output: its
-    vertices and boundary segments, the least any mesher of that mesh must do."""
+def _own_cdt_input(mesh) -> tuple[np.ndarray, np.ndarray]:
+    """A generate call's own output as ``aftmesh.cdt`` input: copies of its vertices
+    and boundary segments."""
+    return np.array(mesh.points, order="C"), np.array(mesh.segments, order="C")
+
+
+def own_cdt_times(points: np.ndarray, segments: np.ndarray, repeat: int) -> dict:
+    """Wall and CPU times of ``aftmesh.cdt`` of a generate call's own output (see
+    _own_cdt_input), the least any mesher of that mesh must do."""
     import aftmesh
 
-    points = np.ascontiguousarray(mesh.points)
-    segments = np.ascontiguousarray(mesh.segments)
-    del mesh
     times, cpu = [], []
     for _ in range(repeat):
         gc.collect()
