@@ -186,6 +186,20 @@ def test_common_case_declines_a_large_mesh_only_where_a_progress_bar_may_show(mo
     assert taken.taken == 1
 
 
+def test_no_standard_error_draws_no_bar_and_raises_nothing(monkeypatch, checked):
+    # sys.stderr is None under pythonw and in some services: a large mesh with the
+    # default progress used to raise AttributeError (isatty on None) in the stages
+    import aftmesh._stages as stages
+
+    monkeypatch.setattr(stages, "PROGRESS_MIN_TRIANGLES", 50)  # "large" from 50 on
+    monkeypatch.setattr("sys.stderr", None)
+    assert stages._progress_callback(None, 51) is None
+    taken = Taken(monkeypatch)
+    checked(aftmesh.generate(box(0, 0, 1, 1), 0.05))
+    assert taken.taken == 1  # no bar can show: the compiled call is taken
+    checked(aftmesh.generate(box(0, 0, 1, 1), 0.05, split_boundary=False))  # the stages
+
+
 def test_common_case_takes_only_plain_numbers(monkeypatch):
     taken = _compare(monkeypatch, box(0, 0, 1, 1), np.float64(0.25))
     assert taken.taken == 0

@@ -12,7 +12,6 @@ declines, and generate runs the stages instead.
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
@@ -96,16 +95,9 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
 
 
 def _progress_limit(progress) -> float:
-    """The triangle hint above which the stages might draw a progress bar (the
-    compiled call declines there): none when progress is False, or None with standard
-    error not a terminal (the rule of _stages._progress_callback)."""
-    if progress is False:
-        return math.inf
-    try:
-        terminal = sys.stderr.isatty()  # one system call, about a microsecond
-    except (AttributeError, ValueError, OSError):
-        terminal = True  # no usable stderr: the stages decide, as they always have
-    return _stages.PROGRESS_MIN_TRIANGLES if terminal else math.inf
+    """The triangle hint above which the stages would draw a progress bar (the
+    compiled call declines there): never when progress is False."""
+    return math.inf if progress is False else _stages.default_bar_limit()
 
 
 def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> Mesh | None:

@@ -70,12 +70,26 @@ class _ProgressBar:
             self.stream.flush()
 
 
+def default_bar_limit() -> float:
+    """The expected triangle count above which progress=None draws a bar:
+    PROGRESS_MIN_TRIANGLES when standard error is a terminal, else never (inf), also
+    when there is no usable standard error (None under pythonw, closed, or an object
+    without isatty)."""
+    try:
+        terminal = sys.stderr.isatty()
+    except (AttributeError, ValueError, OSError):
+        terminal = False
+    return PROGRESS_MIN_TRIANGLES if terminal else math.inf
+
+
 def _progress_callback(progress, expected_triangles: int):
     if callable(progress):
         return progress
     if progress is None:
         # the size first: isatty is a system call, and most meshes are small
-        progress = expected_triangles > PROGRESS_MIN_TRIANGLES and sys.stderr.isatty()
+        progress = (
+            expected_triangles > PROGRESS_MIN_TRIANGLES and expected_triangles > default_bar_limit()
+        )
     return _ProgressBar(sys.stderr) if progress else None
 
 
