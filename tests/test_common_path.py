@@ -187,8 +187,8 @@ def test_common_case_declines_a_large_mesh_only_where_a_progress_bar_may_show(mo
 
 
 def test_no_standard_error_draws_no_bar_and_raises_nothing(monkeypatch, checked):
-    # sys.stderr is None under pythonw and in some services: a large mesh with the
-    # default progress used to raise AttributeError (isatty on None) in the stages
+    # sys.stderr is None under pythonw and in some services: no bar can show there,
+    # and neither path may call isatty on it
     import aftmesh._stages as stages
 
     monkeypatch.setattr(stages, "PROGRESS_MIN_TRIANGLES", 50)  # "large" from 50 on
