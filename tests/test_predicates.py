@@ -952,17 +952,23 @@ def check_acute(a, b, p):
     return got
 
 
-@st.composite
-def near_right_angle(draw, coord):
-    """p rounded onto the circle with diameter ab (Thales: a right angle at p),
-    then moved a few ulps."""
-    a = draw(coord)
-    b = draw(coord)
-    theta = draw(st.floats(min_value=0.0, max_value=2 * math.pi))
+def thales_point(a, b, theta, ulps_x, ulps_y):
+    """The point at angle theta on the circle with diameter ab (Thales: the angle
+    there facing ab is right), rounded, then moved by the given ulps."""
     mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
     r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
-    p = (nudge(mx + r * math.cos(theta), draw(ulps)), nudge(my + r * math.sin(theta), draw(ulps)))
-    return a, b, p
+    return nudge(mx + r * math.cos(theta), ulps_x), nudge(my + r * math.sin(theta), ulps_y)
+
+
+angles = st.floats(min_value=0.0, max_value=2 * math.pi)
+
+
+@st.composite
+def near_right_angle(draw, coord):
+    """a, b from `coord` and p near their Thales circle: about a right angle at p."""
+    a = draw(coord)
+    b = draw(coord)
+    return a, b, thales_point(a, b, draw(angles), draw(ulps), draw(ulps))
 
 
 @PROFILE
@@ -995,13 +1001,7 @@ def test_surely_acute_never_certifies_what_rounding_gets_wrong():
     for _ in range(THALES_SWEEP):
         a = (rng.uniform(-1, 1), rng.uniform(-1, 1))
         b = (rng.uniform(-1, 1), rng.uniform(-1, 1))
-        theta = rng.uniform(0, 2 * math.pi)
-        mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
-        r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
-        p = (
-            nudge(mx + r * math.cos(theta), rng.randint(-3, 3)),
-            nudge(my + r * math.sin(theta), rng.randint(-3, 3)),
-        )
+        p = thales_point(a, b, rng.uniform(0, 2 * math.pi), rng.randint(-3, 3), rng.randint(-3, 3))
         exact = dot_oracle(a, b, p)
         plain = (a[0] - p[0]) * (b[0] - p[0]) + (a[1] - p[1]) * (b[1] - p[1])
         rounding_wrong += (plain > 0) != (exact > 0)
@@ -1026,11 +1026,7 @@ def thales_quad(draw, coord):
     """a, b and two points rounded onto the circle with diameter ab, one on each side
     (two angles of about 90 degrees facing ab, and four nearly cocircular points)."""
     a, b, c = draw(near_right_angle(coord))
-    theta = draw(st.floats(min_value=0.0, max_value=2 * math.pi))
-    mx, my = 0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])
-    r = 0.5 * math.hypot(b[0] - a[0], b[1] - a[1])
-    d = (nudge(mx + r * math.cos(theta), draw(ulps)), nudge(my + r * math.sin(theta), draw(ulps)))
-    return a, b, c, d
+    return a, b, c, thales_point(a, b, draw(angles), draw(ulps), draw(ulps))
 
 
 def check_edge_certificate(a, b, c, d):
