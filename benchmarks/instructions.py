@@ -2,11 +2,16 @@
 valgrind's callgrind: a measure that does not move with the machine's load.
 
 ``python -m benchmarks.instructions [CASE ...]`` meshes each case (the fixed-cost
-strip ``strip-100`` and the "small and real" outlines of ``benchmarks.overhead``, by
-name) in a child process under callgrind, twice: once with ``--calls`` counted calls
+strip ``strip-100``, the "small and real" outlines of ``benchmarks.overhead``, by
+name, and ``square-<h>``: the unit square given by its four corners, at size h) in a
+child process under callgrind, twice: once with ``--calls`` counted calls
 after one warm-up call, once with the warm-up call alone.  The difference over the
 number of calls is one call's cost, imports and warm-up left out; each stage is the
-same difference of the inclusive count of the kernel function that runs it.
+same difference of the inclusive count of the kernel function that runs it.  The
+last column is the number of Lawson flips per point inserted into a Delaunay
+triangulation (boundary CDT, background field and the front's new points together),
+from callgrind's call counts: the cost that grows with the unmeshed region's width
+(benchmarks/README.md, "Scaling").
 
 On a shared machine wall and CPU times of the same build move by tens of percent
 between runs, more than most single optimisations change them; an instruction count
@@ -55,26 +60,97 @@ STAGES = (
 # the C name (after "kernel_", optionally a Cython def wrapper's number).
 _LINE = re.compile(r"^\s*([\d,]+)\s+\([^)]*\)\s+\S*?:__pyx_(?:f|pw)_7aftmesh_7_kernel_(\d*)(\w+)")
 _TOTAL = re.compile(r"^\s*([\d,]+)\s.*PROGRAM TOTALS")
+# Lines of callgrind_annotate --tree=caller: a caller of the function below, with its
+# call count, and the function itself (marked "*").
+_KERNEL_FN = r"\S*?:__pyx_f_7aftmesh_7_kernel_(\w+?)(?:\.\S+)?\s"
+_CALLER = re.compile(r"^\s*[\d,]+\s.*<\s+" + _KERNEL_FN + r"+\(([\d,]+)x\)")
+_CALLEE = re.compile(r"^\s*[\d,]+\s.*\*\s+" + _KERNEL_FN)
+# Calls counted, as (caller, callee): the flips of point insertion, and the two
+# routines that insert a point (one front point each, one bulk point each).
+CALLS = (
+    ("lawson_after_insert", "flip"),
+    ("basic_aft_loop", "update_internal"),
+    ("insert_points", "lawson_after_insert"),
+)
 
 _CHILD = """
 import sys
 sys.path.insert(0, {root!r})
-from benchmarks.overhead import overhead_outline, real_outlines
+from benchmarks.instructions import polygon_and_size
 import aftmesh
 name, calls = {name!r}, {calls}
-cases = [overhead_outline()] + real_outlines()
-case = next(c for c in cases if c.name == name)
-mesh = aftmesh.generate(case.polygon, case.size)
+polygon, size = polygon_and_size(name)
+mesh = aftmesh.generate(polygon, size)
 for _ in range(calls):
-    aftmesh.generate(case.polygon, case.size)
+    aftmesh.generate(polygon, size)
 print(len(mesh.triangles))
 """
 
 
 def case_names() -> list[str]:
+    """The named cases (``square-<h>`` is accepted besides them, for any h > 0)."""
     from .overhead import overhead_outline, real_outlines
 
     return [c.name for c in [overhead_outline()] + real_outlines()]
+
+
+def _square_size(name: str) -> float | None:
+    """h of a ``square-<h>`` name, or None.
+
+    >>> _square_size("square-0.005"), _square_size("square-x"), _square_size("square-0")
+    (0.005, None, None)
+    """
+    kind, _, arg = name.partition("-")
+    try:
+        h = float(arg) if kind == "square" else None
+    except ValueError:
+        return None
+    return h if h is not None and 0.0 < h < float("inf") else None
+
+
+def polygon_and_size(name: str):
+    """The polygon and size of a case, by name (the child process meshes them)."""
+    h = _square_size(name)
+    if h is not None:
+        from shapely.geometry import box
+
+        return box(0.0, 0.0, 1.0, 1.0), h
+    from .overhead import overhead_outline, real_outlines
+
+    case = next(c for c in [overhead_outline()] + real_outlines() if c.name == name)
+    return case.polygon, case.size
+
+
+def parse_calls(text: str) -> dict[str, int]:
+    """The CALLS counts, keyed "caller>callee", from ``callgrind_annotate
+    --tree=caller`` output (a pair that did not occur is absent).
+
+    >>> out = '''
+    ...   9,000 (9.0%)  <  x.c:__pyx_f_7aftmesh_7_kernel_lawson_after_insert (1,200x) [k.so]
+    ...     100 (0.1%)  <  x.c:__pyx_f_7aftmesh_7_kernel_legalize_meshed (7x) [k.so]
+    ...   9,100 (9.1%)  *  x.c:__pyx_f_7aftmesh_7_kernel_flip [k.so]
+    ...
+    ...     500 (0.5%)  <  x.c:__pyx_f_7aftmesh_7_kernel_basic_aft_loop (40x) [k.so]
+    ...     500 (0.5%)  *  x.c:__pyx_f_7aftmesh_7_kernel_update_internal.isra.0 [k.so]'''
+    >>> sorted(parse_calls(out).items())
+    [('basic_aft_loop>update_internal', 40), ('lawson_after_insert>flip', 1200)]
+    """
+    wanted = {f"{a}>{b}" for a, b in CALLS}
+    counts: dict[str, int] = {}
+    callers: list[tuple[str, int]] = []
+    for line in text.splitlines():
+        m = _CALLER.match(line)
+        if m:
+            callers.append((m.group(1), int(m.group(2).replace(",", ""))))
+            continue
+        m = _CALLEE.match(line)
+        if m:
+            for caller, n in callers:
+                key = f"{caller}>{m.group(1)}"
+                if key in wanted:
+                    counts[key] = counts.get(key, 0) + n
+        callers = []
+    return counts
 
 
 def parse_annotate(text: str) -> dict[str, int]:
@@ -104,6 +180,15 @@ def parse_annotate(text: str) -> dict[str, int]:
     return counts
 
 
+def _annotate(out: Path, *options: str) -> str:
+    return subprocess.run(
+        ["callgrind_annotate", *options, "--threshold=100", str(out)],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout
+
+
 def _count(name: str, calls: int) -> tuple[dict[str, int], int]:
     """One callgrind run of the child: (its counts, the triangles of the mesh)."""
     env = runner.worker_env()  # the aftmesh the benchmark workers import
@@ -122,25 +207,29 @@ def _count(name: str, calls: int) -> tuple[dict[str, int], int]:
         if run.returncode != 0 or not out.exists():
             tail = (run.stderr.strip().splitlines() or ["no output"])[-1]
             raise RuntimeError(f"{name}: the counted run failed: {tail}")
-        text = subprocess.run(
-            ["callgrind_annotate", "--inclusive=yes", "--threshold=100", str(out)],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout
-    return parse_annotate(text), int(run.stdout.split()[-1])
+        counts = parse_annotate(_annotate(out, "--inclusive=yes"))
+        counts.update(parse_calls(_annotate(out, "--tree=caller")))
+    return counts, int(run.stdout.split()[-1])
 
 
 def per_call(name: str, calls: int) -> dict:
     """One generate call's instructions on the case, total and per stage."""
     many, triangles = _count(name, calls)
     once, _ = _count(name, 0)
-    keys = ["total"] + [fn for _, fn in STAGES]
+    keys = ["total"] + [fn for _, fn in STAGES] + [f"{a}>{b}" for a, b in CALLS]
     return {
         "triangles": triangles,
         "calls": calls,
         **{k: (many.get(k, 0) - once.get(k, 0)) / calls for k in keys},
     }
+
+
+def flips_per_point(r: dict) -> float:
+    """Lawson flips per inserted point, from per_call's counts (nan: none inserted)."""
+    points = r.get("basic_aft_loop>update_internal", 0) + r.get(
+        "insert_points>lawson_after_insert", 0
+    )
+    return r.get("lawson_after_insert>flip", 0) / points if points else float("nan")
 
 
 def _row(name: str, r: dict, old: dict | None) -> str:
@@ -151,8 +240,10 @@ def _row(name: str, r: dict, old: dict | None) -> str:
         return text
 
     per_tri = r["total"] / max(r["triangles"], 1)
-    return f"{name:<22}{r['triangles']:>8}{per_tri:>9.0f}  " + "  ".join(
-        cell(k) for k in ["total"] + [fn for _, fn in STAGES]
+    return (
+        f"{name:<22}{r['triangles']:>8}{per_tri:>9.0f}  "
+        + "  ".join(cell(k) for k in ["total"] + [fn for _, fn in STAGES])
+        + f"  {flips_per_point(r):>10.2f}"
     )
 
 
@@ -171,7 +262,7 @@ def main(argv=None) -> int:
         print("valgrind (with callgrind_annotate) is not installed: apt install valgrind")
         return 2
     names = args.cases or list(DEFAULT_CASES)
-    unknown = sorted(set(names) - set(case_names()))
+    unknown = sorted(n for n in set(names) - set(case_names()) if _square_size(n) is None)
     if unknown:
         print(f"unknown cases: {', '.join(unknown)} (see --list)")
         return 2
@@ -179,7 +270,11 @@ def main(argv=None) -> int:
     print(f"aftmesh: {runner.locate_aftmesh()}")
     print("millions of instructions per generate call (over the old count with --compare)")
     heads = ["total"] + [label for label, _ in STAGES]
-    print(f"{'case':<22}{'tri':>8}{'per tri':>9}  " + "  ".join(f"{h:>8}" for h in heads))
+    print(
+        f"{'case':<22}{'tri':>8}{'per tri':>9}  "
+        + "  ".join(f"{h:>8}" for h in heads)
+        + f"  {'flips/pt':>10}"
+    )
     results = {}
     for name in names:
         results[name] = per_call(name, args.calls)
