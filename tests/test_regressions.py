@@ -195,10 +195,9 @@ def test_smooth_many_rounds_stops_when_nothing_moves(checked):
 
 
 def test_ctrl_c_during_smoothing_interrupts(time_limit):
-    """SIGINT while smoothing runs (after the compiled loop is done) is only seen when
-    smoothing returns: with smooth=10**6 never.  It should stop within a second.
-    (smooth is now capped at 1000 rounds and stops when a round moves nothing; the
-    test uses the cap.)  The signal is sent SIGNAL_INTO_SMOOTHING_S after smoothing
+    """SIGINT while smoothing runs (after the compiled loop is done) must stop it
+    within a second, not only when smoothing returns.  smooth is capped at 1000 rounds
+    and stops when a round moves nothing; the test asks for the cap.  The signal is sent SIGNAL_INTO_SMOOTHING_S after smoothing
     starts, so it lands inside it: smoothing this square takes tens of milliseconds
     (more in a debug build), and a signal timed from the front's progress instead
     could arrive after generate had returned."""
@@ -577,8 +576,8 @@ def test_gap_of_a_few_ulps_far_from_origin_is_not_closed(checked):
     """A random-walk polygon around 7.1e7, where an ulp is 1.5e-8: one vertex is 3
     ulps from an edge it is not joined to.  Snapping within 8 ulps split the edge there
     and closed the gap, bending the boundary by 2.98e-8 ('mesh segment point ... is
-    2.98e-08 away from every input edge'); the tolerance is now 2 ulps, the rounding of
-    a computed point.  Found by the fuzzer (walk+offset)."""
+    2.98e-08 away from every input edge'); the tolerance is 2 ulps, the rounding of a
+    computed point.  Found by the fuzzer (walk+offset)."""
     # the fuzzer's 11-vertex polygon, cut down to the vertices that keep the failure
     ring = [
         [71066330.76221266, -71066330.08782011],
