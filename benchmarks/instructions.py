@@ -2,9 +2,9 @@
 valgrind's callgrind: a measure that does not move with the machine's load.
 
 ``python -m benchmarks.instructions [CASE ...]`` meshes each case (the fixed-cost
-strip ``strip-100``, the "small and real" outlines of ``benchmarks.overhead``, by
-name, and ``square-<h>``: the unit square given by its four corners, at size h) in a
-child process under callgrind, twice: once with ``--calls`` counted calls
+strip ``strip-100`` and the "small and real" outlines of ``benchmarks.overhead``, by
+name, or any case of the main table, ``square-<h>`` for any h among them, given as that
+table gives it) in a child process under callgrind, twice: once with ``--calls`` counted calls
 after one warm-up call, once with the warm-up call alone.  The difference over the
 number of calls is one call's cost, imports and warm-up left out; each stage is the
 same difference of the inclusive count of the kernel function that runs it.  The
@@ -76,49 +76,47 @@ CALLS = (
 _CHILD = """
 import sys
 sys.path.insert(0, {root!r})
-from benchmarks.instructions import polygon_and_size
+from benchmarks.instructions import generate_args
 import aftmesh
 name, calls = {name!r}, {calls}
-polygon, size = polygon_and_size(name)
-mesh = aftmesh.generate(polygon, size)
+args, kwargs = generate_args(name)
+mesh = aftmesh.generate(*args, **kwargs)
 for _ in range(calls):
-    aftmesh.generate(polygon, size)
+    aftmesh.generate(*args, **kwargs)
 print(len(mesh.triangles))
 """
 
 
 def case_names() -> list[str]:
-    """The named cases (``square-<h>`` is accepted besides them, for any h > 0)."""
+    """The named outlines (generate_args also takes the cases of benchmarks.cases)."""
     from .overhead import overhead_outline, real_outlines
 
     return [c.name for c in [overhead_outline()] + real_outlines()]
 
 
-def _square_size(name: str) -> float | None:
-    """h of a ``square-<h>`` name, or None.
-
-    >>> _square_size("square-0.005"), _square_size("square-x"), _square_size("square-0")
-    (0.005, None, None)
-    """
-    kind, _, arg = name.partition("-")
-    try:
-        h = float(arg) if kind == "square" else None
-    except ValueError:
-        return None
-    return h if h is not None and 0.0 < h < float("inf") else None
-
-
-def polygon_and_size(name: str):
-    """The polygon and size of a case, by name (the child process meshes them)."""
-    h = _square_size(name)
-    if h is not None:
-        from shapely.geometry import box
-
-        return box(0.0, 0.0, 1.0, 1.0), h
+def generate_args(name: str) -> tuple[tuple, dict]:
+    """generate's arguments for a case: a named outline (polygon and size), or any case
+    of ``benchmarks.cases`` (``square-<h>`` for any h, ``naca0012``, ...) given as the
+    main table's ``aft`` gives it.  KeyError or ValueError for an unknown name."""
     from .overhead import overhead_outline, real_outlines
 
-    case = next(c for c in [overhead_outline()] + real_outlines() if c.name == name)
-    return case.polygon, case.size
+    outline = next((c for c in [overhead_outline()] + real_outlines() if c.name == name), None)
+    if outline is not None:
+        return (outline.polygon, outline.size), {}
+    from .cases import build_case
+
+    case = build_case(name)
+    return (case.as_triangle_dict(), case.size_arg), {"split_boundary": False}
+
+
+def _unknown(names: list[str]) -> list[str]:
+    bad = []
+    for name in sorted(set(names) - set(case_names())):
+        try:
+            generate_args(name)
+        except (KeyError, ValueError):
+            bad.append(name)
+    return bad
 
 
 def parse_calls(text: str) -> dict[str, int]:
@@ -262,7 +260,7 @@ def main(argv=None) -> int:
         print("valgrind (with callgrind_annotate) is not installed: apt install valgrind")
         return 2
     names = args.cases or list(DEFAULT_CASES)
-    unknown = sorted(n for n in set(names) - set(case_names()) if _square_size(n) is None)
+    unknown = _unknown(names)
     if unknown:
         print(f"unknown cases: {', '.join(unknown)} (see --list)")
         return 2
