@@ -197,10 +197,11 @@ def test_smooth_many_rounds_stops_when_nothing_moves(checked):
 def test_ctrl_c_during_smoothing_interrupts(time_limit):
     """SIGINT while smoothing runs (after the compiled loop is done) must stop it
     within a second, not only when smoothing returns.  smooth is capped at 1000 rounds
-    and stops when a round moves nothing; the test asks for the cap.  The signal is sent SIGNAL_INTO_SMOOTHING_S after smoothing
-    starts, so it lands inside it: smoothing this square takes tens of milliseconds
-    (more in a debug build), and a signal timed from the front's progress instead
-    could arrive after generate had returned."""
+    and stops when a round moves nothing; the test asks for the cap.  The signal is
+    sent SIGNAL_INTO_SMOOTHING_S after smoothing starts, so it lands inside it:
+    smoothing this square takes tens of milliseconds (more in a debug build), and a
+    signal timed from the front's progress instead could arrive after generate had
+    returned."""
     from aftmesh import _stages
 
     def run():
