@@ -73,6 +73,12 @@ CALLS = (
     ("insert_points", "lawson_after_insert"),
 )
 
+
+def _call_key(caller: str, callee: str) -> str:
+    # the key of a CALLS count in per_call's result (and its --json file)
+    return f"{caller}>{callee}"
+
+
 _CHILD = """
 import sys
 sys.path.insert(0, {root!r})
@@ -110,10 +116,12 @@ def generate_args(name: str) -> tuple[tuple, dict]:
 
 
 def _unknown(names: list[str]) -> list[str]:
+    from .cases import build_case
+
     bad = []
     for name in sorted(set(names) - set(case_names())):
         try:
-            generate_args(name)
+            build_case(name)
         except (KeyError, ValueError):
             bad.append(name)
     return bad
@@ -133,7 +141,7 @@ def parse_calls(text: str) -> dict[str, int]:
     >>> sorted(parse_calls(out).items())
     [('basic_aft_loop>update_internal', 40), ('lawson_after_insert>flip', 1200)]
     """
-    wanted = {f"{a}>{b}" for a, b in CALLS}
+    wanted = {_call_key(a, b) for a, b in CALLS}
     counts: dict[str, int] = {}
     callers: list[tuple[str, int]] = []
     for line in text.splitlines():
@@ -144,7 +152,7 @@ def parse_calls(text: str) -> dict[str, int]:
         m = _CALLEE.match(line)
         if m:
             for caller, n in callers:
-                key = f"{caller}>{m.group(1)}"
+                key = _call_key(caller, m.group(1))
                 if key in wanted:
                     counts[key] = counts.get(key, 0) + n
         callers = []
@@ -214,7 +222,7 @@ def per_call(name: str, calls: int) -> dict:
     """One generate call's instructions on the case, total and per stage."""
     many, triangles = _count(name, calls)
     once, _ = _count(name, 0)
-    keys = ["total"] + [fn for _, fn in STAGES] + [f"{a}>{b}" for a, b in CALLS]
+    keys = ["total"] + [fn for _, fn in STAGES] + [_call_key(a, b) for a, b in CALLS]
     return {
         "triangles": triangles,
         "calls": calls,
@@ -224,10 +232,9 @@ def per_call(name: str, calls: int) -> dict:
 
 def flips_per_point(r: dict) -> float:
     """Lawson flips per inserted point, from per_call's counts (nan: none inserted)."""
-    points = r.get("basic_aft_loop>update_internal", 0) + r.get(
-        "insert_points>lawson_after_insert", 0
-    )
-    return r.get("lawson_after_insert>flip", 0) / points if points else float("nan")
+    flips, front, bulk = (r.get(_call_key(a, b), 0) for a, b in CALLS)
+    points = front + bulk
+    return flips / points if points else float("nan")
 
 
 def _row(name: str, r: dict, old: dict | None) -> str:
