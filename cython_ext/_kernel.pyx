@@ -56,6 +56,7 @@ include "export.pxi"
 include "sizing.pxi"
 include "ordering.pxi"
 include "front.pxi"
+include "scaffold.pxi"
 include "smoothing.pxi"
 include "optimize.pxi"
 include "refine.pxi"
@@ -618,13 +619,15 @@ cdef class Triangulation:
 
     def set_options(self, *, int order=ORDER_SHORTEST, long long max_triangles=-1,
                     double min_area=0.0, double close_factor=0.5, bint swaps=True,
-                    bint greedy=False):
+                    bint greedy=False, bint scaffold=False):
+        """scaffold: the compiled loop plants the scaffold first (scaffold.pxi)."""
         self.A.order = order
         self.A.max_triangles = max_triangles
         self.A.min_area = min_area
         self.A.close_factor = close_factor
         self.A.swaps = swaps
         self.A.greedy = greedy
+        self.A.scaffold_on = scaffold
 
     def convert_to_frontal_edge_set(self):
         _raise_for(&self.T, convert_to_frontal_edge_set(&self.A, &self.T))
@@ -805,7 +808,8 @@ cdef class Triangulation:
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,
                     new_vertices=self.A.n_new, steps=self.A.n_steps,
-                    forced_edges=self.A.n_forced)
+                    forced_edges=self.A.n_forced, scaffold=self.A.n_scaffold_planted,
+                    scaffold_kept=self.A.n_scaffold_kept)
 
     def _check_edge(self, int e):
         if not 0 <= e < 3 * self.T.nt or self.T.tstate[e // 3] == T_FREE:

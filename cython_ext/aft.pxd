@@ -1,6 +1,6 @@
 # The state of the compiled Basic_aft loop (routines in front.pxi, smoothing.pxi):
 # the queue of Get_next_edge, the options, the counters and Check_visible's output.
-from libc.stdint cimport int32_t, int64_t
+from libc.stdint cimport int32_t, int64_t, uint8_t
 from cpython.ref cimport PyObject
 
 from sizing cimport SizeField
@@ -33,6 +33,15 @@ cdef struct Aft:
     int64_t n_new           # vertices created by Update_internal
     int64_t n_steps         # passes through the while loop
     int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
+    # scaffold vertices (scaffold.pxi): vertices scaffold_lo..scaffold_hi of the
+    # unmeshed CDT, scaffold_alive[v - scaffold_lo] while v is one (n_scaffold of them)
+    bint scaffold_on        # plant them (set_options decides)
+    int32_t scaffold_lo, scaffold_hi
+    uint8_t* scaffold_alive
+    int64_t n_scaffold
+    int64_t n_scaffold_planted
+    int64_t n_scaffold_kept     # could not be removed: ordinary vertices of the mesh
+    int32_t crowd_scaffold  # the scaffold vertex is_crowded found too near R
     # Check_visible's output: crossed edges of the line of sight, and where R lies
     int32_t* left
     int32_t* right

@@ -71,6 +71,7 @@ cdef int aft_init(Aft* A) noexcept nogil:
     A.close_factor = DEFAULT_CLOSE_FACTOR
     A.swaps = True
     A.signals_here = True
+    A.scaffold_on = False
     if A.left == NULL or A.right == NULL:
         return ERR_NOMEM
     queue_clear(A)
@@ -83,6 +84,7 @@ cdef void aft_free(Aft* A) noexcept nogil:
     free(A.tail)
     free(A.left)
     free(A.right)
+    free(A.scaffold_alive)
     size_field_free(&A.size)
     memset(A, 0, sizeof(Aft))
 
@@ -364,11 +366,13 @@ cdef bint mesh_size_constraint(Aft* A, Tri* T, int e, const double* R) noexcept 
     C, has exactly N(C) + 2(m - k) triangles (m holes, k components), so
     N(T) + #unmeshed is the final count if no vertex is added from now on, and each
     new vertex adds exactly two.  This is formula (4) with the exact m and k instead of
-    the bound 2(m - 1)."""
+    the bound 2(m - 1).  Each scaffold vertex adds two unmeshed triangles that its
+    removal takes back, so they are not counted."""
     cdef double* pa
     cdef double* pb
     cdef double area
-    if A.max_triangles >= 0 and A.n_meshed + A.n_unmeshed + 2 > A.max_triangles:
+    if A.max_triangles >= 0 and (A.n_meshed + A.n_unmeshed - 2 * A.n_scaffold + 2
+                                 > A.max_triangles):
         return True
     if A.min_area > 0.0:
         pa = P(T, T.tv[e])
@@ -505,7 +509,8 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
     circumcircles contain R, reached without crossing a constraint), because they
     become R's neighbours; only the part of the cavity within close_factor * h of R
     can hold them, so the search stays there.
-    Returns 1 (crowded), 0, or an error."""
+    Returns 1 (crowded), 0, 2 (a scaffold vertex, A.crowd_scaffold, is that near: it
+    goes first), or an error."""
     cdef int n = 0, i, k, e, t, u, j, x, y, z
     cdef double dv2 = (A.close_factor * h) * (A.close_factor * h)
     cdef double de2 = EDGE_PROXIMITY * EDGE_PROXIMITY * dv2
@@ -530,6 +535,9 @@ cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:
             dx = T.xy[2 * x] - R[0]
             dy = T.xy[2 * x + 1] - R[1]
             if dx * dx + dy * dy < dv2:
+                if is_scaffold(A, x):
+                    A.crowd_scaffold = x
+                    return 2
                 return 1
             if blocking(T, e):
                 if _dist2_point_segment(R, P(T, x), P(T, T.tv[nxt(e)])) < de2:
@@ -626,26 +634,44 @@ cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
 
 
 cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
-    """One pass through Figure 5's while loop for the current edge e."""
+    """One pass through Figure 5's while loop for the current edge e.
+
+    The apex S may be a scaffold vertex.  R is then judged against it as against any
+    S: if S is outside the circumcircle of T(E, R), so is the apex the CDT would have
+    without the scaffold (the circles through E's ends are nested on its left), and
+    that apex is only needed when R is not taken.  Then, or when a scaffold vertex is
+    too near R, it is removed and the pass starts again on the same edge."""
     cdef double R[2]
     cdef double h
-    cdef int S, t, vis, crowded
+    cdef int S, t, vis, crowded, a = T.tv[e], b = T.tv[nxt(e)]
     cdef bint new
     compute_new_candidate(A, T, e, R, &h)
-    S = compute_existing_candidate(T, e)
-    new = new_is_preferred(A, T, e, R, S, h) and not mesh_size_constraint(A, T, e, R)
-    if new:
-        vis = check_visible(A, T, e, R)
-        if vis < 0:
-            return vis
-        if vis == 1:
-            # is_crowded answers 1 / 0 or an error code, which must stop the loop
-            # rather than read as "crowded"
-            crowded = is_crowded(A, T, R, h)
-            if crowded < 0:
-                return crowded
-            vis = 0 if crowded else 1
-        new = vis == 1
+    while True:
+        S = compute_existing_candidate(T, e)
+        new = new_is_preferred(A, T, e, R, S, h) and not mesh_size_constraint(A, T, e, R)
+        if new:
+            vis = check_visible(A, T, e, R)
+            if vis < 0:
+                return vis
+            if vis == 1:
+                # is_crowded answers 1 / 0 / 2 or an error code, which must stop the
+                # loop rather than read as "crowded"
+                crowded = is_crowded(A, T, R, h)
+                if crowded < 0:
+                    return crowded
+                if crowded == 2:
+                    e = _remove_in_the_way(A, T, A.crowd_scaffold, a, b)
+                    if e < 0:
+                        return e
+                    continue
+                vis = 0 if crowded else 1
+            new = vis == 1
+        if not new and is_scaffold(A, S):
+            e = _remove_in_the_way(A, T, S, a, b)
+            if e < 0:
+                return e
+            continue
+        break
     if new:
         t = update_internal(A, T, e, R)
     else:
@@ -654,6 +680,16 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
         return t
     A.n_steps += 1
     return add_triangle(A, T, t)
+
+
+cdef int _remove_in_the_way(Aft* A, Tri* T, int v, int a, int b) noexcept nogil:
+    """Remove scaffold vertex v; returns the front edge a->b (its slot may have
+    moved) or an error."""
+    cdef int res = remove_scaffold_vertex(A, T, v)
+    if res < 0:
+        return res
+    res = find_edge(T, a, b)
+    return res if res >= 0 else ERR_INTERNAL
 
 
 cdef int check_signals(Aft* A) noexcept nogil:
@@ -676,6 +712,13 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
     thousand steps to let Ctrl-C through and to report progress."""
     cdef int e, res
     cdef int64_t count = 0
+    if A.n_steps == 0:
+        # a fresh front: the scaffold of a large domain goes in first (scaffold.pxi)
+        res = plant_scaffold(A, T)
+        if res < 0:
+            return res
+        A.n_scaffold_planted = res
+        A.n_unmeshed += 2 * res
     while True:
         e = get_next_edge(A, T)
         if e == NONE:
@@ -695,6 +738,8 @@ cdef int basic_aft_loop(Aft* A, Tri* T) noexcept nogil:
                         return ERR_INTERRUPTED
                     except BaseException:
                         pass                # a broken progress display must not stop meshing
-    if A.n_unmeshed != 0:
+    if A.n_unmeshed != 0 or A.n_scaffold != 0:
         return ERR_INTERNAL
+    if A.scaffold_hi > A.scaffold_lo:
+        return compact_after_scaffold(A, T)
     return 0

@@ -301,7 +301,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
-                    int smooth_rounds, double min_angle):
+                    int smooth_rounds, double min_angle, bint scaffold):
     """The stages of generate from the size field to the refined mesh, for a number
     size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
@@ -378,7 +378,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
         v_out, <int> min(hint, <long long> rules[RULE_MAX_PREALLOCATED]))
     tri.set_size_field(*args)
     tri.set_options(order=order, max_triangles=max_triangles, min_area=float(min_area),
-                    close_factor=close_factor, swaps=swaps, greedy=greedy)
+                    close_factor=close_factor, swaps=swaps, greedy=greedy,
+                    scaffold=scaffold)
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
                             e_out if classify else None, edge_source, max_triangles,
                             smooth_rounds, min_angle, n)

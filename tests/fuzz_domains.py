@@ -1210,6 +1210,8 @@ def options(draw, rich=True):
         out["gradation"] = draw(st.sampled_from([1.0, 1.05, 1.3, 2.0, 100.0]))
     if draw(st.integers(0, 3)) == 0:
         out["max_triangles"] = draw(st.integers(1, 3000))
+    if draw(st.integers(0, 3)) == 0:
+        out["scaffold"] = False
     return out
 
 

@@ -126,6 +126,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         opts.greedy,
         opts.smooth,
         float(opts.min_angle) if refining else 0.0,
+        opts.scaffold,
     )
     if out is None:
         return None

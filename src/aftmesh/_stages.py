@@ -248,6 +248,7 @@ def prepare_front(boundary: Boundary, dom: Domain, field: SizeField, opts: Optio
         close_factor=opts.close_factor,
         swaps=opts.swaps,
         greedy=opts.greedy,
+        scaffold=opts.scaffold,
     )
     return kernel
 
@@ -340,6 +341,10 @@ def assemble(
         # Update_internal calls where T(E, R) was not already a CDT triangle after
         # inserting R, so F and G were inserted by retriangulation (Lemma 3.1 says 0)
         "forced_edges": counters["forced_edges"],
+        # temporary vertices planted in the unmeshed region, and those that could not
+        # be removed again (ordinary vertices of the mesh)
+        "scaffold": counters["scaffold"],
+        "scaffold_kept": counters["scaffold_kept"],
         "smoothing_moves": moves,
         "min_angle": refined,
         "compiled_loop": opts.compiled,

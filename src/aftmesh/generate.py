@@ -41,6 +41,7 @@ _OPTIONS = (
     "tolerance",
     "boundary_tags",
     "min_angle",
+    "scaffold",
 )
 
 
@@ -64,6 +65,7 @@ def generate(
     tolerance: float = 0.0,
     boundary_tags: Mapping[str, Any] | None = None,
     min_angle: float | None = DEFAULT_MIN_ANGLE,
+    scaffold: bool = True,
     partitions: int | None = None,
     client: Any = None,
     out: None = None,
@@ -90,6 +92,7 @@ def generate(
     tolerance: float = 0.0,
     boundary_tags: Mapping[str, Any] | None = None,
     min_angle: float | None = DEFAULT_MIN_ANGLE,
+    scaffold: bool = True,
     partitions: int | None = None,
     client: Any = None,
     out: PathArg,
@@ -115,6 +118,7 @@ def generate(
     tolerance: float = 0.0,
     boundary_tags: Mapping[str, Any] | None = None,
     min_angle: float | None = DEFAULT_MIN_ANGLE,
+    scaffold: bool = True,
     partitions: int | None = None,
     client: Any = None,
     out: PathArg | None = None,
@@ -226,6 +230,16 @@ def generate(
         ``unresolved_triangles``, ``inserted`` (of which ``segment_splits`` on
         segments), ``stopped_by`` (None, 'max_triangles' or 'insertion_cap') and
         ``insertion_cap``; None when the pass is off.
+    scaffold : bool
+        Plant a sparse lattice of temporary points (8 sizes apart, kept 4 sizes from
+        the boundary) in the unmeshed region before the front starts, and remove each
+        one before the front reaches it.  The unmeshed triangles then stay short, so
+        each point the front inserts costs a few flips however open the domain is.
+        The mesh keeps only the points Basic_aft made; ``info['scaffold']`` is the
+        number planted, ``info['scaffold_kept']`` the number that could not be
+        removed and stayed as mesh vertices.  A domain narrower than about 8 sizes
+        gets none, and so the mesh it gets without.  Only the compiled loop plants
+        them (not a Python ``strategy``), never with ``greedy``.  False: never.
     partitions : int, optional
         Cut the domain into this many parts of about equal triangle counts and mesh
         them at once (threads, or Dask tasks with ``client``), then stitch them into

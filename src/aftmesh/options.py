@@ -60,6 +60,7 @@ class Options:
     tolerance: float = 0.0
     boundary_tags: Any = None
     min_angle: float = 0.0  # 0: no minimum-angle pass
+    scaffold: bool = True  # plant the scaffold (scaffold.pxi) where it fits
 
     @property
     def compiled(self) -> bool:
@@ -134,6 +135,7 @@ def check_options(
     tolerance: float = 0.0,
     boundary_tags: Mapping[str, Any] | None = None,
     min_angle: float | None = None,
+    scaffold: bool = True,
 ) -> Options:
     """Validate generate's keyword options; return them as an :class:`Options`."""
     _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary, repair=repair))
@@ -163,6 +165,8 @@ def check_options(
     if tolerance < 0:
         raise InvalidOptionError(f"tolerance must be >= 0, got {tolerance!r}")
     bound = _min_angle(min_angle)
+    if not isinstance(scaffold, (bool, np.bool_)):
+        raise InvalidOptionError(f"scaffold must be True or False, got {scaffold!r}")
     return Options(
         order=order,
         max_triangles=max_triangles,
@@ -179,4 +183,5 @@ def check_options(
         tolerance=tolerance,
         boundary_tags=boundary_tags,
         min_angle=bound,
+        scaffold=bool(scaffold),
     )
