@@ -16,10 +16,10 @@
 # and Lemma 3.1 hold as they are.  The count of formula (4) discounts the two
 # triangles each living scaffold vertex adds.
 #
-# Uses: halfedge.pxd; aft.pxd; predicates.pxi (orient2d, incircle); triangulation.pxi
+# Uses: halfedge.pxd; aft.pxd; predicates.pxi (orient2d); triangulation.pxi
 # (add_vertex, locate, insert_vertex_at, flip, in_circle_ext, find_edge,
-# reserve_stack, _grow); sizing.pxi (size_at); front.pxi (_tri_area,
-# _dist2_point_segment); refine.pxi (_d2).
+# reserve_stack, _grow); sizing.pxi (size_at); front.pxi (_dist2_point_segment);
+# refine.pxi (_d2).
 from libc.math cimport ceil, fabs
 
 # Lattice spacing in units of the local size: the unmeshed triangles then stay within
