@@ -178,7 +178,9 @@ cdef int plant_scaffold(Aft* A, Tri* T) noexcept nogil:
     cdef double* pts
     A.scaffold_lo = A.scaffold_hi = T.nv
     A.n_scaffold = 0
-    if not A.scaffold_on or A.greedy:
+    # with max_triangles the lattice would follow the size asked, not the capped
+    # output: a huge request would plant millions of vertices for a small mesh
+    if not A.scaffold_on or A.greedy or A.max_triangles >= 0:
         return 0
     pts = <double*> malloc(2 * cap * sizeof(double))
     if pts == NULL:

@@ -239,7 +239,8 @@ def generate(
         number planted, ``info['scaffold_kept']`` the number that could not be
         removed and stayed as mesh vertices.  A domain narrower than about 8 sizes
         gets none, and so the mesh it gets without.  Only the compiled loop plants
-        them (not a Python ``strategy``), never with ``greedy``.  False: never.
+        them (not a Python ``strategy``), never with ``greedy`` or ``max_triangles``.
+        False: never.
     partitions : int, optional
         Cut the domain into this many parts of about equal triangle counts and mesh
         them at once (threads, or Dask tasks with ``client``), then stitch them into
