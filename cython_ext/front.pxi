@@ -366,13 +366,12 @@ cdef bint mesh_size_constraint(Aft* A, Tri* T, int e, const double* R) noexcept 
     C, has exactly N(C) + 2(m - k) triangles (m holes, k components), so
     N(T) + #unmeshed is the final count if no vertex is added from now on, and each
     new vertex adds exactly two.  This is formula (4) with the exact m and k instead of
-    the bound 2(m - 1).  Each scaffold vertex adds two unmeshed triangles that its
-    removal takes back, so they are not counted."""
+    the bound 2(m - 1).  (No scaffold is planted under max_triangles, so no scaffold
+    vertex is among the unmeshed triangles' vertices here.)"""
     cdef double* pa
     cdef double* pb
     cdef double area
-    if A.max_triangles >= 0 and (A.n_meshed + A.n_unmeshed - 2 * A.n_scaffold + 2
-                                 > A.max_triangles):
+    if A.max_triangles >= 0 and A.n_meshed + A.n_unmeshed + 2 > A.max_triangles:
         return True
     if A.min_area > 0.0:
         pa = P(T, T.tv[e])
@@ -487,17 +486,25 @@ cdef inline double _dist2_point_segment(const double* p, const double* a,
     return px * px + py * py
 
 
-cdef inline bint _in_circle_float(const double* a, const double* b, const double* c,
-                                  const double* d) noexcept nogil:
-    """Plain floating-point incircle: only for is_crowded's heuristic cavity, where a
-    wrong answer in a near-tie merely looks at one triangle more or less (the exact
-    predicate there cost a tenth of the run time on near-equilateral meshes)."""
+cdef inline double _in_circle_value(const double* a, const double* b, const double* c,
+                                    const double* d) noexcept nogil:
+    """The incircle determinant in plain floating point (> 0: d inside the circle of
+    the counter-clockwise a, b, c), for heuristics only: orders and searches that a
+    near-tie cannot make wrong."""
     cdef double adx = a[0] - d[0], ady = a[1] - d[1]
     cdef double bdx = b[0] - d[0], bdy = b[1] - d[1]
     cdef double cdx = c[0] - d[0], cdy = c[1] - d[1]
     return ((adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
             + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
-            + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady)) > 0.0
+            + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady))
+
+
+cdef inline bint _in_circle_float(const double* a, const double* b, const double* c,
+                                  const double* d) noexcept nogil:
+    """Plain floating-point incircle: only for is_crowded's heuristic cavity, where a
+    wrong answer in a near-tie merely looks at one triangle more or less (the exact
+    predicate there cost a tenth of the run time on near-equilateral meshes)."""
+    return _in_circle_value(a, b, c, d) > 0.0
 
 
 cdef int is_crowded(Aft* A, Tri* T, const double* R, double h) noexcept nogil:

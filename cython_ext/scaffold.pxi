@@ -13,13 +13,13 @@
 # output's vertices are those Basic_aft would have made.  Each removal takes finitely
 # many flips and there are finitely many scaffold vertices, so the termination
 # argument of §2 is unchanged; the unmeshed triangulation stays a CDT, so Check_visible
-# and Lemma 3.1 hold as they are.  The count of formula (4) discounts the two
-# triangles each living scaffold vertex adds.
+# and Lemma 3.1 hold as they are.  Nothing is planted under max_triangles (formula
+# (4)): the lattice follows the size asked, not the capped count.
 #
 # Uses: halfedge.pxd; aft.pxd; predicates.pxi (orient2d); triangulation.pxi
 # (add_vertex, locate, insert_vertex_at, flip, in_circle_ext, find_edge,
-# reserve_stack, _grow); sizing.pxi (size_at); front.pxi (_dist2_point_segment);
-# refine.pxi (_d2).
+# reserve_stack, _grow); sizing.pxi (size_at); front.pxi (_dist2_point_segment,
+# _in_circle_value); refine.pxi (_d2).
 from libc.math cimport ceil, fabs
 
 # Lattice spacing in units of the local size: the unmeshed triangles then stay within
@@ -235,16 +235,6 @@ cdef double _ear_score(Tri* T, int v, int e) noexcept nogil:
     cdef double* pv = P(T, v)
     cdef double o = (pb[0] - pd[0]) * (pc[1] - pd[1]) - (pb[1] - pd[1]) * (pc[0] - pd[0])
     return _in_circle_value(pd, pb, pc, pv) / o
-
-
-cdef inline double _in_circle_value(const double* a, const double* b, const double* c,
-                                    const double* d) noexcept nogil:
-    cdef double adx = a[0] - d[0], ady = a[1] - d[1]
-    cdef double bdx = b[0] - d[0], bdy = b[1] - d[1]
-    cdef double cdx = c[0] - d[0], cdy = c[1] - d[1]
-    return ((adx * adx + ady * ady) * (bdx * cdy - cdx * bdy)
-            + (bdx * bdx + bdy * bdy) * (cdx * ady - adx * cdy)
-            + (cdx * cdx + cdy * cdy) * (adx * bdy - bdx * ady))
 
 
 cdef int _star_removable(Tri* T, int v, int* degree) noexcept nogil:
