@@ -28,7 +28,8 @@
 
 #
 # Uses: halfedge.pxd; aft.pxd (Aft); predicates.pxi (orient2d, incircle);
-# triangulation.pxi (split_triangle, split_edge, find_edge, locate, Lawson flips).
+# triangulation.pxi (split_triangle, split_edge, find_edge, locate, Lawson flips,
+# legalize_meshed_with).
 from halfedge cimport *
 from aft cimport Aft
 from libc.math cimport fabs, ldexp, frexp, ceil
@@ -651,6 +652,34 @@ cdef int _split_inward(Tri* T, int f, int v) noexcept nogil:
     return k
 
 
+cdef int _queue_flipped(void* ctx, Tri* T, int t) noexcept nogil:
+    return _push_tri(<Refine*> ctx, T, t)
+
+
+cdef int _legalize_split(Refine* R, Tri* T, int v) noexcept nogil:
+    """Finish the CDT after v was put on a segment.  v is a rounded point, up to an
+    ulp or two off the segment's line, so an edge at v can be illegal too, not only
+    the edges facing v that Lawson's insertion flips look at (between nearly
+    collinear points of one chain it is).  Every edge of the meshed triangles around
+    v is tested, flips go on from there, and the triangles they make are queued."""
+    cdef int e0 = T.vhe[v], e = e0, n = 0, guard = 0
+    while True:
+        if T.tstate[e // 3] == T_MESHED:
+            if reserve_stack(T, n + 3):
+                return ERR_NOMEM
+            T.stack[n] = e
+            T.stack[n + 1] = nxt(e)
+            T.stack[n + 2] = prv(e)
+            n += 3
+        e = T.twin[prv(e)]
+        guard += 1
+        if e == e0:
+            break
+        if guard > ROTATION_CAP:
+            return ERR_INTERNAL
+    return legalize_meshed_with(T, n, _queue_flipped, R)
+
+
 cdef int _split_segment(Refine* R, Aft* A, Tri* T, int u, int w) noexcept nogil:
     """Split segment piece u-w (if it still is one).  Returns ACT_INSERTED, ACT_DROPPED
     or an error."""
@@ -693,6 +722,8 @@ cdef int _split_segment(Refine* R, Aft* A, Tri* T, int u, int w) noexcept nogil:
         if add == 1:
             n = 2
     res = lawson_after_insert(T, n)
+    if res == 0:
+        res = _legalize_split(R, T, v)
     if res < 0:
         return res
     R.n_meshed += add

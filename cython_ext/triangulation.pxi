@@ -330,11 +330,22 @@ cdef inline bint illegal_meshed_edge(Tri* T, int e) noexcept nogil:
     return incircle(pa, pb, pc, pd) > 0
 
 
+# Called with each triangle a flip of legalize_meshed_with made, so that a caller can
+# look at the new triangles (the minimum-angle pass queues the bad ones).
+ctypedef int (*flip_hook)(void* ctx, Tri* T, int t) noexcept nogil
+
+
 cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
     """Lawson flips inside the meshed region (Add_triangle): flip every unconstrained
     edge between two meshed triangles whose far apex is inside the circumcircle, until
     none is left.  T.stack[0:nstack] holds the edges that may have become illegal."""
-    cdef int e, f, t0, t1
+    return legalize_meshed_with(T, nstack, NULL, NULL)
+
+
+cdef int legalize_meshed_with(Tri* T, int nstack, flip_hook hook, void* ctx) noexcept nogil:
+    """legalize_meshed, calling hook(ctx, T, t) (when not NULL) on both triangles of
+    each flip; a non-zero return of the hook stops it and is returned."""
+    cdef int e, f, t0, t1, res
     while nstack > 0:
         nstack -= 1
         e = T.stack[nstack]
@@ -348,6 +359,12 @@ cdef int legalize_meshed(Tri* T, int nstack) noexcept nogil:
                 T.vdirty[T.tv[prv(e)]] = 1
                 T.vdirty[T.tv[prv(f)]] = 1
             flip(T, e)
+            if hook != NULL:
+                res = hook(ctx, T, t0)
+                if res == 0:
+                    res = hook(ctx, T, t1)
+                if res != 0:
+                    return res
             if reserve_stack(T, nstack + 4):
                 return ERR_NOMEM
             # the four outer edges of the new pair may now be illegal

@@ -933,3 +933,41 @@ def test_min_angle_pass_keeps_the_domain_whole_after_noding_crossing_pieces(chec
     mesh = checked(aftmesh.generate(domain, 0.24936012138533437))
     assert any("crossings" in note for note in mesh.info["cleanup"])
     assert abs(mesh.area() - Polygon(ring).area) < 1e-12
+
+
+def test_segment_split_keeps_the_cdt_between_nearly_collinear_points_of_one_chain(checked):
+    """A constraint line 7.5e-15 from another over 3e-6 (coordinates near 1e-6): the
+    min-angle pass splits it again and again, and the split points, rounded up to an
+    ulp off the line, made slivers whose edge at the new point failed the empty-circle
+    test.  Lawson's insertion flips test only the edges facing the new point; the
+    edges at it are tested now too.  Found by the fuzzer (constraints+small)."""
+    ring = [
+        (2.5910246302000074e-6, 1.646572899304797e-6),
+        (1.6281484909304535e-6, 4.836130504359068e-6),
+        (-2.110703157653677e-6, 6.649209892636615e-6),
+        (-2.0591335165924648e-6, 1.8256028736028756e-6),
+        (-4.611495708304436e-6, 2.1848301408779364e-6),
+        (-6.0041495652948995e-6, -1.5934392953838959e-6),
+        (-2.894638863493558e-6, -2.9621640980803116e-6),
+        (-9.83702605511402e-7, -3.352038617283015e-6),
+        (1.6580736235952286e-7, -5.597045641707061e-6),
+        (2.139856919934493e-6, -2.4232861272243103e-6),
+        (6.9200968017165956e-6, 1.059762640343866e-20),
+    ]
+    poly = Polygon(ring)
+    lines = [
+        LineString([(0, 0), (0, 0), (0, -4.720718738089232e-6)]),
+        LineString(
+            [(0, 0), (0, 4.0715236794831314e-6), (7.593101415021886e-15, -2.9585940539651016e-6)]
+            + [(0, 0)]
+        ),
+    ]
+    points = [
+        Point(2.910843968896003e-6, 0),
+        Point(0, -2.360359369044616e-6),
+        Point(3.1955232542910544e-15, 1.1129296255180303e-6),
+    ]
+    domain = GeometryCollection([poly, *lines, *points])
+    case = fd.FuzzCase("constraints+small", domain, None, {"max_triangles": 2000}, [poly], lines)
+    mesh = fd.run_case(case, check=checked)
+    assert mesh is not None and mesh.info["min_angle"]["stopped_by"] == "max_triangles"
