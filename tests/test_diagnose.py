@@ -40,3 +40,12 @@ def test_boundary_class_touches_an_input_segment():
 def test_without_smoothing_nothing_is_blamed_on_it():
     d = diagnose(_domain(), 0.06, threshold=0.95, smooth=0)
     assert d.counts["smoothing"] == 0
+
+
+def test_diagnosis_of_a_domain_wide_enough_for_the_scaffold(checked):
+    """A domain many sizes wide gets the scaffold in the compiled loop and none in the
+    Python loop; both runs are made without it, so their vertices correspond."""
+    d = diagnose(box(0.0, 0.0, 1.0, 1.0), 0.02, threshold=0.99)
+    checked(d.mesh)
+    assert d.mesh.info["scaffold"] == 0
+    assert sum(d.counts.values()) == len(d.bad) > 0

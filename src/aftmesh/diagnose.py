@@ -26,7 +26,9 @@ final mesh whose radius ratio is below a threshold with the first class that app
 It needs the same vertex numbering in both meshes: smoothing moves vertices but
 neither adds nor removes any, and the Python loop gives the compiled loop's mesh.  So it
 diagnoses Basic_aft and smoothing, before the minimum-angle pass (``min_angle=None``
-unless given: the pass adds vertices of its own).
+unless given: the pass adds vertices of its own), and without the scaffold
+(``scaffold=False`` in both runs: the Python loop never plants it, and its removals
+change where the compiled loop's fronts put their points).
 """
 
 from __future__ import annotations
@@ -169,7 +171,7 @@ def diagnose(
     True
     """
     rec = _Recorder()
-    options = {"min_angle": None, **options}
+    options = {"min_angle": None, **options, "scaffold": False}
     plain = generate(domain, size, **{**options, "smooth": 0, "strategy": rec})
     mesh = generate(domain, size, **options)
     if len(plain.points) != len(mesh.points):
