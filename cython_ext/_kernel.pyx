@@ -59,6 +59,7 @@ include "front.pxi"
 include "scaffold.pxi"
 include "smoothing.pxi"
 include "optimize.pxi"
+include "valence.pxi"
 include "refine.pxi"
 include "inputs.pxi"
 include "nearby.pxi"
@@ -772,13 +773,14 @@ cdef class Triangulation:
             if problems:
                 raise KernelError("after Basic_aft: " + "; ".join(problems[:5]))
 
-    def smooth(self, int first_movable, int passes):
+    def smooth(self, int first_movable, int passes, bint valence=True):
         """Smooth the vertices first_movable.. (those Basic_aft created) for `passes`
-        rounds, each followed by Delaunay flips; returns the number of moves."""
+        rounds, each followed by Delaunay flips, with the valence flips after the
+        first (smoothing.pxi; valence=False: none); returns the number of moves."""
         cdef int res
         self._note_thread()
         with nogil:
-            res = smooth(&self.A, &self.T, first_movable, passes)
+            res = smooth(&self.A, &self.T, first_movable, passes, valence)
         _reraise_pending(&self.A)
         _raise_for(&self.T, res)
         return res

@@ -212,13 +212,13 @@ cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* b
             return
 
 
-cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
+cdef int _optimize_vertex(Tri* T, int v, bint swaps) noexcept nogil:
     """Move v to the best of the candidate places (see the top of this file) when that
     lowers the cost of its triangles without lowering their worst shape, and every
-    triangle stays counter-clockwise by the exact orient2d; then restore the CDT
-    around it.  A vertex that may not move (see _gather_ring), or whose triangles are
-    all shaped better than OPT_SKIP, stays.  Returns 1 if v moved, 0 if not, or an
-    error."""
+    triangle stays counter-clockwise by the exact orient2d; then, with `swaps`,
+    restore the CDT around it.  A vertex that may not move (see _gather_ring), or
+    whose triangles are all shaped better than OPT_SKIP, stays.  Returns 1 if v
+    moved, 0 if not, or an error."""
     cdef int e0 = T.vhe[v], e, k, n
     cdef Ring R
     cdef double cand[6]
@@ -263,7 +263,7 @@ cdef int _optimize_vertex(Tri* T, int v) noexcept nogil:
         e = T.twin[prv(e)]
         if e == e0:
             break
-    return _legalize_around(T, v)
+    return _legalize_around(T, v) if swaps else 1
 
 
 cdef int _legalize_around(Tri* T, int v) noexcept nogil:

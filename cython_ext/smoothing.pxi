@@ -7,12 +7,24 @@
 #
 # _shape is the quality measure optimize.pxi's moves are judged by.
 #
+# With VALENCE_ROUNDS rounds or more, the valence flips (valence.pxi) come after the
+# first round: the second round then moves the vertices without swaps, the Delaunay
+# property is restored from every triangle that changed, and the rounds go on.
+#
 # Uses: halfedge.pxd (Tri.vdirty, which triangulation.pxi's legalize_meshed sets);
-# aft.pxd (Aft); front.pxi (check_signals); optimize.pxi (_optimize_vertex).
+# aft.pxd (Aft); front.pxi (check_signals); optimize.pxi (_optimize_vertex);
+# valence.pxi (valence_flips); triangulation.pxi (legalize_meshed, reserve_stack).
 from halfedge cimport *
 from aft cimport Aft
-from libc.stdlib cimport malloc, free
+from libc.stdlib cimport malloc, calloc, free
 from libc.string cimport memset
+from libc.stdint cimport uint8_t
+
+# The valence flips need a round before them (vertices settled where the front left
+# them), the settling round after them, and a round once the Delaunay swaps have run:
+# with fewer rounds, smoothing is what it was without them.
+cdef enum:
+    VALENCE_ROUNDS = 3
 
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
@@ -26,11 +38,13 @@ cdef inline double _shape(const double* a, const double* b, const double* c) noe
     return 3.4641016151377544 * area2 / s
 
 
-cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
+cdef int smooth(Aft* A, Tri* T, int first_movable, int passes,
+                bint valence=True) noexcept nogil:
     """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), each
     followed by Delaunay flips around the vertex, stopping early when a round moves
-    nothing; signals are checked after each round.  Returns the number of vertex
-    moves, or an error.
+    nothing; signals are checked after each round.  With `valence` and at least
+    VALENCE_ROUNDS rounds, the valence flips come after the first (see the top of
+    this file).  Returns the number of vertex moves, or an error.
 
     After the first round a vertex is judged again only if it moved or its ring
     changed since it was last judged (a neighbour moved, or a flip touched it): the
@@ -41,13 +55,59 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
         return ERR_NOMEM
     memset(dirty, 1, T.nv)
     T.vdirty = dirty
-    res = _smooth_rounds(A, T, first_movable, passes)
+    if valence and passes >= VALENCE_ROUNDS and first_movable < T.nv:
+        res = _smooth_with_valence(A, T, first_movable, passes)
+    else:
+        res = _smooth_rounds(A, T, first_movable, passes, NULL, True)
     T.vdirty = NULL
     free(dirty)
     return res
 
 
-cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
+cdef int _smooth_with_valence(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
+    """A round, the valence flips, a settling round without swaps, the Delaunay
+    swaps from every triangle with a flipped or moved vertex, the other rounds."""
+    cdef int moved, res, flips, left = passes - 1
+    cdef uint8_t* touched = <uint8_t*> calloc(T.nv if T.nv > 0 else 1, 1)
+    if touched == NULL:
+        return ERR_NOMEM
+    moved = _smooth_rounds(A, T, first_movable, 1, NULL, True)
+    flips = valence_flips(T, first_movable, touched) if moved >= 0 else 0
+    res = flips
+    if flips > 0:
+        res = _smooth_rounds(A, T, first_movable, 1, touched, False)
+        if res >= 0:
+            moved += res
+            left -= 1
+            res = _legalize_touched(T, touched)
+    free(touched)
+    if moved < 0 or res < 0:
+        return moved if moved < 0 else res
+    res = _smooth_rounds(A, T, first_movable, left, NULL, True)
+    return res if res < 0 else moved + res
+
+
+cdef int _legalize_touched(Tri* T, const uint8_t* touched) noexcept nogil:
+    """Lawson flips from the edges of every meshed triangle with a touched vertex."""
+    cdef int t, n = 0
+    if reserve_stack(T, 3 * T.nt):
+        return ERR_NOMEM
+    for t in range(T.nt):
+        if T.tstate[t] != T_MESHED:
+            continue
+        if touched[T.tv[3 * t]] or touched[T.tv[3 * t + 1]] or touched[T.tv[3 * t + 2]]:
+            T.stack[n] = 3 * t
+            T.stack[n + 1] = 3 * t + 1
+            T.stack[n + 2] = 3 * t + 2
+            n += 3
+    return legalize_meshed(T, n)
+
+
+cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes, uint8_t* touched,
+                        bint swaps) noexcept nogil:
+    """`passes` rounds over the marked vertices (see smooth); without `swaps` the moves
+    leave the Delaunay swaps to the caller, and touched (when not NULL) gets every
+    vertex that moved."""
     cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
@@ -55,11 +115,13 @@ cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes) noexcept 
             if not T.vdirty[v]:
                 continue
             T.vdirty[v] = 0
-            res = _optimize_vertex(T, v)
+            res = _optimize_vertex(T, v, swaps)
             if res < 0:
                 return res
             if res:
                 _mark_ring(T, v)
+                if touched != NULL:
+                    touched[v] = 1
             moved_now += res
         moved += moved_now
         if check_signals(A) != 0:

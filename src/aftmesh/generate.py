@@ -174,12 +174,15 @@ def generate(
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
-        equilateral, a few places (the mean of its neighbours, the mean of the apexes
-        that would make its triangles equilateral, the optimal-Delaunay point, steps
-        towards its worst triangle's ideal apex, then a gradient step) and moves it
-        to the one that lowers the sum of 1/shape^2 of its triangles without making
-        the worst of them worse, keeping every triangle counter-clockwise (exact);
-        edge swaps around it then restore the constrained Delaunay property.  Input
+        equilateral, a few places (the mean of its neighbours, the optimal-Delaunay
+        point, steps towards its worst triangle's ideal apex, then a gradient step)
+        and moves it to the one that lowers the sum of 1/shape^2 of its triangles
+        without making the worst of them worse, keeping every triangle
+        counter-clockwise (exact); edge swaps around it then restore the constrained
+        Delaunay property.  With 3 rounds or more, edges are flipped after the first
+        round towards six triangles at every vertex (where fronts met, smoothing
+        alone leaves vertices of five and seven), the second round lets the vertices
+        settle without swaps, and the swaps then make the mesh a CDT again.  Input
         vertices never move.
         ``info['smoothing_moves']`` counts the moves.
     strategy : Strategy, optional
