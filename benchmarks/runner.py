@@ -22,8 +22,6 @@ HOW_TO_BUILD = (
     "checkout (python setup.py build_ext --inplace); src/ is used only when the "
     "kernel is built there."
 )
-# A kernel being rebuilt in place is briefly unimportable: one retry after this pause.
-REBUILD_PAUSE_S = 2.0
 
 
 class SetupError(RuntimeError):
@@ -54,7 +52,7 @@ def locate_aftmesh() -> str:
     otherwise the installed package.  Raises `SetupError` saying how to fix it."""
     if "file" not in _AFTMESH:
         parts = [str(ROOT)] + ([str(SRC)] if kernel_in_place() else [])
-        code = "import aftmesh, aftmesh._kernel; print(aftmesh.__file__)"
+        code = "import aftmesh, aftmesh._kernel as k; print(aftmesh.__file__); print(k.__file__)"
         try:
             probe = subprocess.run(
                 [sys.executable, "-c", code],
@@ -70,7 +68,8 @@ def locate_aftmesh() -> str:
             tail = (probe.stderr.strip().splitlines() or ["no output"])[-1]
             where = "src/ (kernel built in place)" if len(parts) > 1 else "the installed packages"
             raise SetupError(f"cannot import aftmesh from {where}: {tail}\n{HOW_TO_BUILD}")
-        _AFTMESH.update(parts=parts, file=probe.stdout.strip())
+        package, kernel = probe.stdout.strip().splitlines()[-2:]
+        _AFTMESH.update(parts=parts, file=package, kernel=kernel, build=_build_of(kernel))
         if len(parts) > 1 and str(SRC) not in sys.path:
             sys.path.insert(0, str(SRC))  # this process checks availability the same way
     return _AFTMESH["file"]
@@ -98,42 +97,57 @@ def _import_failed(err: str) -> bool:
     return err.startswith(("ImportError", "ModuleNotFoundError")) and "aftmesh" in err
 
 
+def _build_of(kernel: str) -> tuple[int, int] | None:
+    """The compiled kernel file's size and modification time: they change when it is
+    rebuilt (None: it is gone)."""
+    try:
+        st = os.stat(kernel)
+    except OSError:
+        return None
+    return st.st_size, st.st_mtime_ns
+
+
+def _same_build() -> None:
+    """Stop the run if the kernel the workers import is no longer the one it started
+    with: each worker imports it afresh, so a rebuild in the middle of a run would
+    put two builds' figures in one table."""
+    locate_aftmesh()
+    if _build_of(_AFTMESH["kernel"]) != _AFTMESH["build"]:
+        raise SetupError(
+            f"the kernel {_AFTMESH['kernel']} changed since the run started (rebuilt?): "
+            "its figures would mix two builds; run again once the build is final"
+        )
+
+
 def run_job(job: dict, timeout: float) -> dict:
     """Run one job in a fresh interpreter; a failure becomes ``{"error": ...}``, except
-    a worker that cannot import aftmesh, which stops the run (`SetupError`)."""
-    for attempt in range(2):
-        t0 = time.perf_counter()
-        try:
-            proc = subprocess.run(
-                [sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
-                cwd=ROOT,
-                env=worker_env(),
-                capture_output=True,
-                text=True,
-                timeout=timeout,
-            )
-        except subprocess.TimeoutExpired:
-            return {"error": f"timeout after {timeout:.0f} s"}
-        wall = time.perf_counter() - t0
-        lines = [ln for ln in proc.stdout.splitlines() if ln.startswith(MARK)]
-        if lines:
-            res = json.loads(lines[-1][len(MARK) :])
-        else:
-            tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
-            res = {"error": f"worker exit {proc.returncode}: {tail}"}
-        res["wall"] = wall
-        err = res.get("error", "")
-        if (
-            "_kernel" in err
-            and ("Import" in err or "undefined symbol" in err)
-            and kernel_in_place()
-            and attempt == 0
-        ):
-            time.sleep(REBUILD_PAUSE_S)
-            continue
-        if _import_failed(err):
-            raise SetupError(f"a worker cannot import aftmesh: {err}\n{HOW_TO_BUILD}")
-        return res
+    a worker that cannot import aftmesh, or a kernel rebuilt before or during the job,
+    which stops the run (`SetupError`)."""
+    _same_build()
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "benchmarks.worker", json.dumps(job)],
+            cwd=ROOT,
+            env=worker_env(),
+            capture_output=True,
+            text=True,
+            timeout=timeout,
+        )
+    except subprocess.TimeoutExpired:
+        return {"error": f"timeout after {timeout:.0f} s"}
+    wall = time.perf_counter() - t0
+    _same_build()
+    lines = [ln for ln in proc.stdout.splitlines() if ln.startswith(MARK)]
+    if lines:
+        res = json.loads(lines[-1][len(MARK) :])
+    else:
+        tail = (proc.stderr.strip().splitlines() or ["no output"])[-1]
+        res = {"error": f"worker exit {proc.returncode}: {tail}"}
+    res["wall"] = wall
+    err = res.get("error", "")
+    if _import_failed(err):
+        raise SetupError(f"a worker cannot import aftmesh: {err}\n{HOW_TO_BUILD}")
     return res
 
 
