@@ -28,6 +28,7 @@ cdef struct Aft:
     double close_factor     # New_is_preferred takes S when |S - R| < close_factor * h
     bint swaps              # Add_triangle keeps the meshed region a CDT by edge swaps
     bint greedy             # New_is_preferred is always false
+    int32_t nv_input        # vertices of the domain's CDT (below: input vertices)
     int64_t n_meshed        # N(T)
     int64_t n_unmeshed      # triangles of the unmeshed CDT
     int64_t n_new           # vertices created by Update_internal

@@ -170,7 +170,9 @@ def generate(
         than ``close_factor * h`` (a constrained edge it would face: 0.65 times that, so
         fronts closer than about 1.2 h connect across).  ``h`` is the local size, but
         at most 1.5 times the side of R's triangle where the size is well above the
-        front edge (short input edges).
+        front edge (short input edges), and 1.2 times that where the size is uniform
+        and the apex of R's edge is not an input vertex (it keeps the seams where two
+        fronts' lattices meet one triangle wide).
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
