@@ -205,14 +205,14 @@ def scaling_tables(sc: dict) -> list[str]:
     out = []
     hdr = (
         "| h | mesher | triangles | time (median) | CPU (median) | runs | tri/s | "
-        "peak mem (MiB) | bytes / triangle | CPU / aftmesh.cdt of own output |"
+        "peak mem (MiB) | bytes / triangle | CPU / aftmesh.cdt of own output | RR mean |"
     )
     out += [hdr, _rule(hdr)]
     for r in sc["rows"]:
         label = _label(r["mesher"])
         if "median" not in r:
             out.append(
-                f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 7
+                f"| {r['h']:g} | {label} | ERROR: {_esc(str(r.get('error')))} |" + " - |" * 8
             )
             continue
         n = r["triangles"]
@@ -222,7 +222,8 @@ def scaling_tables(sc: dict) -> list[str]:
             f"{_t(r.get('cpu_median'))} | {len(r['times'])} | "
             f"{_rate(n / r['median'])} | {r['mem_mib']:.1f} | "
             f"{r['mem_mib'] * 1048576 / n:.0f} | "
-            f"{_f(r['cpu_median'] / own if own else None, '{:.2f}')} |"
+            f"{_f(r['cpu_median'] / own if own else None, '{:.2f}')} | "
+            f"{_f(r.get('stats', {}).get('rr_mean'), '{:.5f}')} |"
         )
     out.append("")
     for m, fit in sc["fits"].items():
