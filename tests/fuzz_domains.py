@@ -557,8 +557,11 @@ def _triangle_not_delaunay(P, theirs, T, unexplained, seg) -> bool:
 
 
 # How far (in units in the last place of the coordinates) a mesh vertex on a segment
-# may lie off its input edge: its own rounding, refine.pxi's one-ulp nudge, a margin.
-SEGMENT_POINT_ULPS = 4
+# may lie off its input edge: noding.py puts a lone point or a line's free end within
+# its snapping tolerance (4 ulps) on the segment, so a piece may run that far off the
+# edge; a split point on such a piece adds its own rounding and refine.pxi's one-ulp
+# nudge.
+SEGMENT_POINT_ULPS = 6
 
 
 def area_tolerance(case: FuzzCase, area: float) -> float:

@@ -971,3 +971,39 @@ def test_segment_split_keeps_the_cdt_between_nearly_collinear_points_of_one_chai
     case = fd.FuzzCase("constraints+small", domain, None, {"max_triangles": 2000}, [poly], lines)
     mesh = fd.run_case(case, check=checked)
     assert mesh is not None and mesh.info["min_angle"]["stopped_by"] == "max_triangles"
+
+
+def test_pieces_of_a_line_a_lone_point_was_snapped_onto_stay_within_the_oracle(checked):
+    """Constraint lines from the centre of a heptagon moved by 4e7, and a lone point 6e-8
+    above the centre: 2.98023222e-8 from the slanted line, just inside noding's snapping
+    tolerance (4 ulps, 2.98023224e-8), so the slanted line is split there and its first
+    piece runs 4 ulps off the input edge.  The points the size and the minimum-angle
+    pass put on that piece are up to 4.5 ulps off ('mesh segment point ... is 3.33e-08
+    away from every input edge'), which the oracle's 4 ulps refused although the
+    snapping rule allows it.  Found by the long hypothesis profile (constraints+offset)."""
+    poly = Polygon(
+        [
+            (40000000.766044445, -39999999.35721239),
+            (40000000.17364818, -39999999.01519225),
+            (39999999.5, -39999999.1339746),
+            (39999999.060307376, -39999999.65797985),
+            (39999999.060307376, -40000000.34202015),
+            (39999999.5, -40000000.8660254),
+            (40000001.0, -40000000.0),
+        ]
+    )
+    end = (40000000.46984631, -39999999.18620232)
+    lines = [
+        LineString([(4e7, -4e7), (4e7, -39999999.5)]),
+        LineString([(4e7, -4e7), end]),
+        LineString([(4e7, -4e7), end]),
+    ]
+    points = [
+        Point(4e7, -4e7),
+        Point(4e7, -39999999.99999994),
+        Point(4e7, -39999999.75),
+        Point(40000000.234923154, -39999999.59310116),
+    ]
+    domain = GeometryCollection([poly, *lines, *points])
+    case = fd.FuzzCase("constraints+offset", domain, None, {}, [poly], lines, points)
+    assert fd.run_case(case, check=checked) is not None
