@@ -44,6 +44,7 @@ from shapely.geometry import GeometryCollection, LineString, MultiPolygon, Point
 import aftmesh
 from aftmesh import _kernel
 from aftmesh.checks import check_mesh
+from aftmesh.noding import SNAP_ULPS
 
 __all__ = [
     "FuzzCase",
@@ -558,10 +559,10 @@ def _triangle_not_delaunay(P, theirs, T, unexplained, seg) -> bool:
 
 # How far (in units in the last place of the coordinates) a mesh vertex on a segment
 # may lie off its input edge: noding.py puts a lone point or a line's free end within
-# its snapping tolerance (4 ulps) on the segment, so a piece may run that far off the
-# edge; a split point on such a piece adds its own rounding and refine.pxi's one-ulp
-# nudge.
-SEGMENT_POINT_ULPS = 6
+# its snapping tolerance (SNAP_ULPS) on the segment, so a piece may run that far off
+# the edge; a split point on such a piece adds its own rounding and refine.pxi's
+# one-ulp nudge.
+SEGMENT_POINT_ULPS = SNAP_ULPS + 2
 
 
 def area_tolerance(case: FuzzCase, area: float) -> float:
