@@ -61,6 +61,8 @@ include "smoothing.pxi"
 include "optimize.pxi"
 include "valence.pxi"
 include "refine.pxi"
+include "chains.pxi"
+include "sliding.pxi"
 include "inputs.pxi"
 include "nearby.pxi"
 include "discretize.pxi"
@@ -773,14 +775,16 @@ cdef class Triangulation:
             if problems:
                 raise KernelError("after Basic_aft: " + "; ".join(problems[:5]))
 
-    def smooth(self, int first_movable, int passes, bint valence=True):
+    def smooth(self, int first_movable, int passes, bint valence=True, int n_corners=-1):
         """Smooth the vertices first_movable.. (those Basic_aft created) for `passes`
         rounds, each followed by Delaunay flips, with the valence flips after the
-        first (smoothing.pxi; valence=False: none); returns the number of moves."""
+        first (smoothing.pxi; valence=False: none); the points n_corners..first_movable
+        that split an input segment slide along it (-1: none do; n_corners is the
+        number of input vertices).  Returns the number of moves."""
         cdef int res
         self._note_thread()
         with nogil:
-            res = smooth(&self.A, &self.T, first_movable, passes, valence)
+            res = smooth(&self.A, &self.T, first_movable, passes, valence, n_corners)
         _reraise_pending(&self.A)
         _raise_for(&self.T, res)
         return res

@@ -202,6 +202,7 @@ cdef struct Pieces:
     const int32_t* edge_source
     long long max_triangles
     int first_movable
+    int n_corner                # input vertices: the split points after them slide
     int smooth_rounds
     bint refining
     # out
@@ -235,7 +236,7 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
     if P.res >= 0:
         P.res = basic_aft_loop(A, T)
     if P.res >= 0 and P.smooth_rounds:
-        P.res = smooth(A, T, P.first_movable, P.smooth_rounds)
+        P.res = smooth(A, T, P.first_movable, P.smooth_rounds, True, P.n_corner)
         P.moves = P.res
     P.t_aft = _clock()
     if P.res >= 0 and P.refining:
@@ -246,7 +247,8 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
 cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               const int32_t[:, ::1] seg, object piece_edge,
                               const int32_t[::1] edge_source, long long max_triangles,
-                              int smooth_rounds, double min_angle, int n_corners):
+                              int smooth_rounds, bint slide, double min_angle,
+                              int n_corners):
     """_mesh_pieces on tri (its size field and options set), with the def layer's
     error handling: None where the stages must run, else (merged vertices, smoothing
     moves, the refine pass's counts or None, t_cdt, t_aft)."""
@@ -264,6 +266,7 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
         P.edge_source = &edge_source[0]
     P.max_triangles = max_triangles
     P.first_movable = nv
+    P.n_corner = n_corners if slide else -1
     P.smooth_rounds = smooth_rounds
     P.refining = min_angle != 0
     memset(&R, 0, sizeof(Refine))
@@ -301,14 +304,15 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
-                    int smooth_rounds, double min_angle, bint scaffold):
+                    int smooth_rounds, bint slide, double min_angle, bint scaffold):
     """The stages of generate from the size field to the refined mesh, for a number
     size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
     the exterior ring source 0.  rounds: _order.round_keys, called for the BRIO
     round keys of the background's and the boundary's points; max_pieces: the most
     boundary pieces allowed; progress_limit: the triangle hint above which a progress
-    bar may be wanted; min_angle 0: no pass.
+    bar may be wanted; slide: smoothing slides the boundary's split points along
+    their input edges; min_angle 0: no pass.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
@@ -382,7 +386,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     scaffold=scaffold)
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
                             e_out if classify else None, edge_source, max_triangles,
-                            smooth_rounds, min_angle, n)
+                            smooth_rounds, slide, min_angle, n)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

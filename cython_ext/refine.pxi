@@ -281,59 +281,10 @@ cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
 # ---------------------------------------------------------------- chains
 
 cdef int _chain_init(Refine* R, Tri* T) noexcept nogil:
-    """vend[2v], vend[2v+1] = the ends of the chain of segment pieces through v, for
-    every vertex inside a chain (not an input vertex, exactly two segment pieces)."""
-    cdef int t, k, e, u, w, prev, nxtv, f, n, guard
-    cdef int32_t* deg = <int32_t*> malloc((T.nv + 1) * sizeof(int32_t))
-    if deg == NULL or _vend_reserve(R, T.nv):
-        free(deg)
+    """R.vend for every vertex of T (chains.pxi's chain_ends)."""
+    if _vend_reserve(R, T.nv):
         return ERR_NOMEM
-    memset(deg, 0, (T.nv + 1) * sizeof(int32_t))
-    for t in range(T.nt):
-        if T.tstate[t] == T_FREE:
-            continue
-        for k in range(3):
-            e = 3 * t + k
-            if (T.eflag[e] & E_SEGMENT) and T.tv[e] >= 0:
-                deg[T.tv[e]] += 1
-    for t in range(T.nt):
-        if T.tstate[t] == T_FREE:
-            continue
-        for k in range(3):
-            e = 3 * t + k
-            u = T.tv[e]
-            if not (T.eflag[e] & E_SEGMENT) or u < 0 or (u >= R.n_corner and deg[u] == 2):
-                continue
-            # walk from the chain end u along e to the other end; then mark the inside
-            prev = u
-            w = T.tv[nxt(e)]
-            n = 0
-            while w >= R.n_corner and deg[w] == 2 and n <= T.nv:
-                f = T.vhe[w]
-                guard = 0
-                while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt(f)] == prev:
-                    f = T.twin[prv(f)]
-                    guard += 1
-                    if guard > ROTATION_CAP:
-                        free(deg)
-                        return ERR_INTERNAL
-                nxtv = T.tv[nxt(f)]
-                R.vend[2 * w] = u
-                prev = w
-                w = nxtv
-                n += 1
-            # second pass: the far end is w; write it on the same vertices
-            prev = u
-            nxtv = T.tv[nxt(e)]
-            while nxtv != w:
-                R.vend[2 * nxtv + 1] = w
-                f = T.vhe[nxtv]
-                while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt(f)] == prev:
-                    f = T.twin[prv(f)]
-                prev = nxtv
-                nxtv = T.tv[nxt(f)]
-    free(deg)
-    return 0
+    return chain_ends(T, R.n_corner, R.vend)
 
 
 cdef int _chains_of(Refine* R, Tri* T, int p, int32_t* out, int cap) noexcept nogil:

@@ -1,9 +1,11 @@
 # Smoothing after the front has closed (optional, on by default in generate()).
 #
-# Each pass moves vertices that Basic_aft created (the input vertices never move) by
-# optimize.pxi's _optimize_vertex, which keeps every triangle counter-clockwise (exact
-# orient2d) and restores the constrained Delaunay property by Lawson flips around each
-# moved vertex, so the result is still the CDT of its vertices and the input edges.
+# Each pass moves vertices that Basic_aft created by optimize.pxi's _optimize_vertex,
+# and slides the points that split an input segment along it by sliding.pxi's
+# slide_vertex (the input vertices never move).  Both keep every triangle
+# counter-clockwise (exact orient2d) and restore the constrained Delaunay property by
+# Lawson flips around each moved vertex, so the result is still the CDT of its
+# vertices and the input edges.
 #
 # _shape is the quality measure optimize.pxi's moves are judged by.
 #
@@ -13,18 +15,26 @@
 #
 # Uses: halfedge.pxd (Tri.vdirty, which triangulation.pxi's legalize_meshed sets);
 # aft.pxd (Aft); front.pxi (check_signals); optimize.pxi (_optimize_vertex);
-# valence.pxi (valence_flips); triangulation.pxi (legalize_meshed, reserve_stack).
+# sliding.pxi (slide_vertex); chains.pxi (chain_ends); valence.pxi (valence_flips);
+# triangulation.pxi (legalize_meshed, reserve_stack).
 from halfedge cimport *
 from aft cimport Aft
 from libc.stdlib cimport malloc, calloc, free
 from libc.string cimport memset
-from libc.stdint cimport uint8_t
+from libc.stdint cimport uint8_t, int32_t
 
 # The valence flips need a round before them (vertices settled where the front left
 # them), the settling round after them, and a round once the Delaunay swaps have run:
 # with fewer rounds, smoothing is what it was without them.
 cdef enum:
     VALENCE_ROUNDS = 3
+
+
+cdef struct Movable:
+    # which vertices smoothing may move
+    int first_sliding   # from here to first_movable: split points, which slide
+    int first_movable   # from here on: Basic_aft's vertices, which move freely
+    int32_t* vend       # the ends of each split point's chain (chains.pxi); NULL: none
 
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
@@ -38,44 +48,56 @@ cdef inline double _shape(const double* a, const double* b, const double* c) noe
     return 3.4641016151377544 * area2 / s
 
 
-cdef int smooth(Aft* A, Tri* T, int first_movable, int passes,
-                bint valence=True) noexcept nogil:
-    """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), each
-    followed by Delaunay flips around the vertex, stopping early when a round moves
-    nothing; signals are checked after each round.  With `valence` and at least
-    VALENCE_ROUNDS rounds, the valence flips come after the first (see the top of
-    this file).  Returns the number of vertex moves, or an error.
+cdef int smooth(Aft* A, Tri* T, int first_movable, int passes, bint valence=True,
+                int n_corner=-1) noexcept nogil:
+    """Up to `passes` rounds of moves of vertices first_movable.. (optimize.pxi), and
+    of the split points n_corner..first_movable along their segments (sliding.pxi;
+    n_corner: the number of input vertices, -1 or first_movable for none), each
+    followed by Delaunay flips, stopping early when a round moves nothing; signals are
+    checked after each round.  With `valence` and at least VALENCE_ROUNDS rounds, the
+    valence flips come after the first (see the top of this file).  Returns the
+    number of vertex moves, or an error.
 
     After the first round a vertex is judged again only if it moved or its ring
     changed since it was last judged (a neighbour moved, or a flip touched it): the
     judgement depends on nothing else, so the others would stay where they are."""
-    cdef int res
+    cdef int res = 0
+    cdef Movable M
     cdef uint8_t* dirty = <uint8_t*> malloc(T.nv if T.nv > 0 else 1)
-    if dirty == NULL:
-        return ERR_NOMEM
+    M.first_movable = first_movable
+    M.first_sliding = n_corner if 0 <= n_corner < first_movable else first_movable
+    M.vend = NULL
+    if M.first_sliding < first_movable:
+        M.vend = <int32_t*> malloc(2 * T.nv * sizeof(int32_t))
+        res = ERR_NOMEM if M.vend == NULL else chain_ends(T, M.first_sliding, M.vend)
+    if dirty == NULL or res < 0:
+        free(dirty)
+        free(M.vend)
+        return ERR_NOMEM if dirty == NULL else res
     memset(dirty, 1, T.nv)
     T.vdirty = dirty
     if valence and passes >= VALENCE_ROUNDS and first_movable < T.nv:
-        res = _smooth_with_valence(A, T, first_movable, passes)
+        res = _smooth_with_valence(A, T, &M, passes)
     else:
-        res = _smooth_rounds(A, T, first_movable, passes, NULL, True)
+        res = _smooth_rounds(A, T, &M, passes, NULL, True)
     T.vdirty = NULL
     free(dirty)
+    free(M.vend)
     return res
 
 
-cdef int _smooth_with_valence(Aft* A, Tri* T, int first_movable, int passes) noexcept nogil:
+cdef int _smooth_with_valence(Aft* A, Tri* T, const Movable* M, int passes) noexcept nogil:
     """A round, the valence flips, a settling round without swaps, the Delaunay
     swaps from every triangle with a flipped or moved vertex, the other rounds."""
     cdef int moved, res, flips, left = passes - 1
     cdef uint8_t* touched = <uint8_t*> calloc(T.nv if T.nv > 0 else 1, 1)
     if touched == NULL:
         return ERR_NOMEM
-    moved = _smooth_rounds(A, T, first_movable, 1, NULL, True)
-    flips = valence_flips(T, first_movable, touched) if moved >= 0 else 0
+    moved = _smooth_rounds(A, T, M, 1, NULL, True)
+    flips = valence_flips(T, M.first_movable, touched) if moved >= 0 else 0
     res = flips
     if flips > 0:
-        res = _smooth_rounds(A, T, first_movable, 1, touched, False)
+        res = _smooth_rounds(A, T, M, 1, touched, False)
         if res >= 0:
             moved += res
             left -= 1
@@ -83,7 +105,7 @@ cdef int _smooth_with_valence(Aft* A, Tri* T, int first_movable, int passes) noe
     free(touched)
     if moved < 0 or res < 0:
         return moved if moved < 0 else res
-    res = _smooth_rounds(A, T, first_movable, left, NULL, True)
+    res = _smooth_rounds(A, T, M, left, NULL, True)
     return res if res < 0 else moved + res
 
 
@@ -103,7 +125,7 @@ cdef int _legalize_touched(Tri* T, const uint8_t* touched) noexcept nogil:
     return legalize_meshed(T, n)
 
 
-cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes, uint8_t* touched,
+cdef int _smooth_rounds(Aft* A, Tri* T, const Movable* M, int passes, uint8_t* touched,
                         bint swaps) noexcept nogil:
     """`passes` rounds over the marked vertices (see smooth); without `swaps` the moves
     leave the Delaunay swaps to the caller, and touched (when not NULL) gets every
@@ -111,11 +133,16 @@ cdef int _smooth_rounds(Aft* A, Tri* T, int first_movable, int passes, uint8_t* 
     cdef int p, v, res, moved = 0, moved_now
     for p in range(passes):
         moved_now = 0
-        for v in range(first_movable, T.nv):
+        for v in range(M.first_sliding, T.nv):
             if not T.vdirty[v]:
                 continue
             T.vdirty[v] = 0
-            res = _optimize_vertex(T, v, swaps)
+            if v >= M.first_movable:
+                res = _optimize_vertex(T, v, swaps)
+            elif M.vend[2 * v] >= 0:
+                res = slide_vertex(T, v, M.vend[2 * v], M.vend[2 * v + 1], swaps)
+            else:
+                continue
             if res < 0:
                 return res
             if res:

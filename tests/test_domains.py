@@ -211,8 +211,14 @@ def test_coordinate_ring_clockwise_and_closed():
         assert dc.coordinate_keys(ccw) <= dc.coordinate_keys(mesh.points)
         assert sorted(r[3] for r in count_formula(mesh)) == [0]
     # the boundary is discretized alike whatever the ring's orientation or closure
-    # (up to rounding: a piece's ends are computed from either end of the edge)
-    bnd = [np.asarray(m.points)[np.unique(m.segments)] for m in meshes]
+    # (up to rounding: a piece's ends are computed from either end of the edge);
+    # the split points not slid, as smoothing would in each mesh's own order
+    unsmoothed = [
+        aftmesh.generate(r, 0.3, slide_boundary=False) for r in (ccw, cw_closed, ccw.tolist())
+    ]
+    for mesh in unsmoothed:
+        valid(mesh, 4.0)
+    bnd = [np.asarray(m.points)[np.unique(m.segments)] for m in unsmoothed]
     assert len(bnd[0]) == len(bnd[1]) == len(bnd[2])
     for other in bnd[1:]:
         dist = np.linalg.norm(bnd[0][:, None, :] - other[None, :, :], axis=2)

@@ -24,8 +24,11 @@ def _mesh(domain, size, valence, monkeypatch, **kw):
     case), its smoothing with or without the valence flips."""
     real = _stages.smooth
 
-    def smooth(kernel, boundary, rounds):
-        return kernel.smooth(len(boundary.vertices), rounds, valence) if rounds else 0
+    def smooth(kernel, boundary, dom, opts):
+        if not opts.smooth:
+            return 0
+        n_corners = len(dom.vertices) if opts.slides else -1
+        return kernel.smooth(len(boundary.vertices), opts.smooth, valence, n_corners)
 
     monkeypatch.setattr(_stages, "smooth", smooth)
     try:

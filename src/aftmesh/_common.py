@@ -125,6 +125,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         opts.swaps,
         opts.greedy,
         opts.smooth,
+        opts.slides,
         float(opts.min_angle) if refining else 0.0,
         opts.scaffold,
     )

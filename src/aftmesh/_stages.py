@@ -273,10 +273,15 @@ def run_front(kernel, opts: Options, triangle_hint: int) -> None:
         )
 
 
-def smooth(kernel, boundary: Boundary, rounds: int) -> int:
+def smooth(kernel, boundary: Boundary, dom: Domain, opts: Options) -> int:
     """Smoothing rounds after the front has closed; the number of vertex moves.  The
-    vertices of the discretized boundary (numbered first) never move."""
-    return kernel.smooth(len(boundary.vertices), rounds) if rounds else 0
+    input vertices (numbered first) never move; the points that split an input edge
+    (numbered next, up to the discretized boundary's end) slide along it with
+    slide_boundary, else stay."""
+    if not opts.smooth:
+        return 0
+    n_corners = len(dom.vertices) if opts.slides else -1
+    return kernel.smooth(len(boundary.vertices), opts.smooth, n_corners=n_corners)
 
 
 def refine(kernel, dom: Domain, opts: Options) -> dict | None:

@@ -35,6 +35,7 @@ _OPTIONS = (
     "gradation",
     "close_factor",
     "smooth",
+    "slide_boundary",
     "strategy",
     "progress",
     "repair",
@@ -59,6 +60,7 @@ def generate(
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
     smooth: int = 3,
+    slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
     repair: bool = False,
@@ -86,6 +88,7 @@ def generate(
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
     smooth: int = 3,
+    slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
     repair: bool = False,
@@ -112,6 +115,7 @@ def generate(
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
     smooth: int = 3,
+    slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
     repair: bool = False,
@@ -181,12 +185,21 @@ def generate(
         and moves it to the one that lowers the sum of 1/shape^2 of its triangles
         without making the worst of them worse, keeping every triangle
         counter-clockwise (exact); edge swaps around it then restore the constrained
-        Delaunay property.  With 3 rounds or more, edges are flipped after the first
-        round towards six triangles at every vertex (where fronts met, smoothing
-        alone leaves vertices of five and seven), the second round lets the vertices
-        settle without swaps, and the swaps then make the mesh a CDT again.  Input
-        vertices never move.
+        Delaunay property.  With ``slide_boundary``, a point that splits an input
+        edge is judged the same way, but only along its input edge, so the domain
+        does not change.  With 3 rounds or more, edges are flipped after the
+        first round towards six triangles at every vertex (where fronts met,
+        smoothing alone leaves vertices of five and seven), the second round lets
+        the vertices settle without swaps, and the swaps then make the mesh a CDT
+        again.  Input vertices never move.
         ``info['smoothing_moves']`` counts the moves.
+    slide_boundary : bool
+        Let smoothing slide the points that split an input edge along it (default).
+        False keeps them where the boundary's discretization put them, which then
+        depends only on the boundary and the size: two domains meshed apart get the
+        same points on an edge they share (unless the minimum-angle pass splits it).
+        Never with ``greedy`` (its mesh is the CDT of the discretized boundary), and
+        a run in more than one part never slides them, since its parts share them.
     strategy : Strategy, optional
         Subtasks to plug in (see :class:`aftmesh.aft.Strategy`); the Python loop runs
         then, otherwise the compiled one.
@@ -310,7 +323,7 @@ def generate(
     kernel = _stages.prepare_front(boundary, dom, field, opts)
     t_cdt = time.perf_counter()
     _stages.run_front(kernel, opts, boundary.triangle_hint)
-    moves = _stages.smooth(kernel, boundary, opts.smooth)
+    moves = _stages.smooth(kernel, boundary, dom, opts)
     t_aft = time.perf_counter()
     refined = _stages.refine(kernel, dom, opts)
     t_refine = time.perf_counter()

@@ -56,11 +56,18 @@ class Options:
     smooth: int
     strategy: Strategy | None
     progress: Any
+    slide_boundary: bool = True
     repair: bool = False
     tolerance: float = 0.0
     boundary_tags: Any = None
     min_angle: float = 0.0  # 0: no minimum-angle pass
     scaffold: bool = True  # plant the scaffold (scaffold.pxi) where it fits
+
+    @property
+    def slides(self) -> bool:
+        """Whether smoothing slides the points that split input edges: greedy's mesh
+        is the CDT of the discretized boundary itself."""
+        return self.slide_boundary and self.split_boundary and not self.greedy
 
     @property
     def compiled(self) -> bool:
@@ -136,9 +143,18 @@ def check_options(
     boundary_tags: Mapping[str, Any] | None = None,
     min_angle: float | None = None,
     scaffold: bool = True,
+    slide_boundary: bool = True,
 ) -> Options:
     """Validate generate's keyword options; return them as an :class:`Options`."""
-    _check_flags(dict(greedy=greedy, swaps=swaps, split_boundary=split_boundary, repair=repair))
+    _check_flags(
+        dict(
+            greedy=greedy,
+            swaps=swaps,
+            split_boundary=split_boundary,
+            repair=repair,
+            slide_boundary=slide_boundary,
+        )
+    )
     if not isinstance(order, str) or order not in ORDERS:
         raise InvalidOptionError(
             f"order={order!r} is not a valid option, must be one of {sorted(ORDERS)}"
@@ -177,6 +193,7 @@ def check_options(
         gradation=gradation,
         close_factor=float(close_factor),
         smooth=int(smooth),
+        slide_boundary=bool(slide_boundary),
         strategy=strategy,
         progress=progress,
         repair=bool(repair),
