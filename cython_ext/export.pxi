@@ -20,7 +20,9 @@ cdef int number_output(Tri* T, const uint8_t* keep, int32_t* tri_index, int32_t*
                        int32_t* tris, int32_t* regions) noexcept nogil:
     """Number the kept triangles (tri_index, -1 elsewhere on entry) and their vertices
     (vmap, -1 on entry) in slot order; tris[3i + k] = output vertex k of output
-    triangle i, regions[i] its region.  Returns the number of output vertices."""
+    triangle i, regions[i] its region.  Returns the number of output vertices.
+    tris may be T.tv and regions T.tregion: output triangle i is never after slot
+    i, and each entry is read before its place is written."""
     cdef int t, k, u, ntri = 0, nvo = 0
     for t in range(T.nt):
         if keep[t]:
@@ -44,10 +46,11 @@ cdef void output_points(Tri* T, const int32_t* vmap, double* pts) noexcept nogil
             pts[2 * vmap[u] + 1] = T.xy[2 * u + 1]
 
 
-cdef int output_segments(Tri* T, const uint8_t* keep, const int32_t* vmap, int32_t* segs,
+cdef int output_segments(Tri* T, const uint8_t* keep, int32_t* segs,
                          int32_t* ids) noexcept nogil:
-    """segs / ids = the input-segment edges of the output, each once, with their
-    segment ids; with segs == NULL only counts them.  Returns the number of segments."""
+    """segs / ids = the input-segment edges of the output, each once, by kernel
+    vertex (see renumber), with their segment ids; with segs == NULL only counts
+    them.  Returns the number of segments."""
     cdef int t, k, e, u, ns = 0
     for t in range(T.nt):
         if not keep[t]:
@@ -58,23 +61,35 @@ cdef int output_segments(Tri* T, const uint8_t* keep, const int32_t* vmap, int32
                 u = T.twin[e] // 3
                 if not keep[u] or u > t:
                     if segs != NULL:
-                        segs[2 * ns] = vmap[T.tv[e]]
-                        segs[2 * ns + 1] = vmap[T.tv[nxt(e)]]
+                        segs[2 * ns] = T.tv[e]
+                        segs[2 * ns + 1] = T.tv[nxt(e)]
                         ids[ns] = T.eseg[e]
                     ns += 1
     return ns
 
 
+cdef void renumber(int32_t* ids, int n, const int32_t* vmap) noexcept nogil:
+    """ids[i] = vmap[ids[i]] for the first n."""
+    cdef int i
+    for i in range(n):
+        ids[i] = vmap[ids[i]]
+
+
 cdef void output_neighbors(Tri* T, const uint8_t* keep, const int32_t* tri_index,
                            int32_t* nbr) noexcept nogil:
     """nbr[3i + k] = the output triangle across the edge opposite vertex k of output
-    triangle i (-1 on entry, kept where there is none).  Reads only T.twin."""
-    cdef int t, k, u
+    triangle i, -1 where there is none (tri_index is -1 off the output).  Reads only
+    T.twin, which nbr may be: a triangle's three twins are read before its row is
+    written, and output triangle i is never after slot i."""
+    cdef int t, u0, u1, u2, i
     for t in range(T.nt):
         if not keep[t]:
             continue
-        for k in range(3):
-            # the edge opposite vertex k is half-edge 3t + (k+1) % 3
-            u = T.twin[3 * t + (k + 1) % 3] // 3
-            if keep[u]:
-                nbr[3 * tri_index[t] + k] = tri_index[u]
+        # the edge opposite vertex k is half-edge 3t + (k+1) % 3
+        u0 = T.twin[3 * t + 1] // 3
+        u1 = T.twin[3 * t + 2] // 3
+        u2 = T.twin[3 * t] // 3
+        i = tri_index[t]
+        nbr[3 * i] = tri_index[u0]
+        nbr[3 * i + 1] = tri_index[u1]
+        nbr[3 * i + 2] = tri_index[u2]
