@@ -4,6 +4,8 @@ distinct points of a vertex list, repeated segments, the BRIO round keys."""
 
 from __future__ import annotations
 
+import gc
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -383,8 +385,17 @@ def test_arrays_release_gives_the_same_arrays_and_leaves_an_empty_kernel(n):
     released = kernel.arrays(release=True)
     assert released.keys() == kept.keys()
     for name in kept:
+        assert released[name].shape == kept[name].shape, name
+        assert released[name].dtype == kept[name].dtype, name
         assert released[name].tobytes() == kept[name].tobytes(), name
     assert len(kept["triangles"]) > 0
     again = kernel.arrays()
     assert all(len(again[name]) == 0 for name in ("points", "triangles", "segments"))
     assert kernel.state_counts() == (0, 0, 0)
+    # the triangles, regions and neighbours are the kernel's own blocks, now owned by
+    # the arrays: they outlive the kernel and may be written
+    del kernel, again
+    gc.collect()
+    for name in ("triangles", "regions", "neighbors"):
+        assert released[name].flags.writeable and released[name].flags.c_contiguous
+        assert released[name].tobytes() == kept[name].tobytes(), name
