@@ -4,9 +4,9 @@
 # size alone, before any triangle exists.  Where the front then closes against such a
 # point at a poor angle (a short piece, a size that changes along the segment, a
 # corner's neighbour), no move of the interior vertices mends the triangle on the
-# piece: on the real-world group most of the poor triangles next to the boundary have
-# a split point as a vertex.  A split point may move along its segment without
-# changing the domain, so smoothing slides it there too:
+# piece (on the real-world group's touching-holes6, two thirds of the poor triangles
+# next to the boundary had a split point as a vertex).  A split point may move along
+# its segment without changing the domain, so smoothing slides it there too:
 #
 # * its place is computed on the line of its chain's ends (chains.pxi), a + t (b - a),
 #   as every split point is, so it stays within the rounding of its input segment
@@ -33,10 +33,10 @@ from libc.math cimport sqrt, INFINITY
 
 
 cdef int _fan_start(Tri* T, int v) noexcept nogil:
-    """The segment piece leaving v whose triangle is meshed (the first side around
-    v), or NONE when v may not slide: a ghost triangle around it, not exactly two
-    segment pieces at it, no meshed triangle on one, or more than OPT_RING_CAP
-    triangles."""
+    """A segment piece leaving v whose triangle is meshed (where the fan of
+    _gather_fan starts), or NONE when v may not slide: a ghost triangle around it,
+    not exactly two segment pieces at it, neither piece's triangle meshed, or more
+    than OPT_RING_CAP triangles around it."""
     cdef int e0 = T.vhe[v], e = e0, s = NONE, pieces = 0, n = 0
     if e0 < 0:
         return NONE
