@@ -33,7 +33,7 @@ from aft cimport Aft
 from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBuffer_Release, PyObject_GetBuffer
 from cpython.ref cimport Py_XDECREF, PyObject
 from libc.stdlib cimport malloc, free, realloc
-from cython cimport view
+from cython.view cimport array as cvarray
 
 import math
 import threading
@@ -184,7 +184,7 @@ cdef object _adopt_i32(int32_t** array, Py_ssize_t rows, Py_ssize_t cols):
     reuses memory the kernel has already written instead of faulting in fresh pages
     (a tenth of the time of a 9-million-triangle run went to zeroing those)."""
     cdef void* q
-    cdef view.array a
+    cdef cvarray a
     cdef object shape = [rows] if cols == 1 else [rows, cols]
     if rows == 0:
         _release(<void**> array)
@@ -193,8 +193,8 @@ cdef object _adopt_i32(int32_t** array, Py_ssize_t rows, Py_ssize_t cols):
     if q == NULL:
         q = array[0]                # keep the larger block: only memory is lost
     array[0] = NULL
-    a = view.array(shape=tuple(shape), itemsize=sizeof(int32_t), format="i", mode="c",
-                   allocate_buffer=False)
+    a = cvarray(shape=tuple(shape), itemsize=sizeof(int32_t), format="i", mode="c",
+                allocate_buffer=False)
     a.data = <char*> q
     a.callback_free_data = free
     return np.asarray(a)

@@ -1,12 +1,12 @@
 """Smoothing slides the points that split an input edge along it (slide_boundary)."""
 
+import domain_cases as dc
+import fuzz_domains as fd
 import numpy as np
 import pytest
 from shapely.geometry import GeometryCollection, LineString, Point, Polygon, box
 
 import aftmesh
-import domain_cases as dc
-import fuzz_domains as fd
 from aftmesh.mesh import triangle_quality
 
 
@@ -51,8 +51,9 @@ def test_interface_split_points_slide_on_their_line_with_both_regions_kept(check
     outer = box(-1.5, -1.5, 1.5, 1.5)
     inner = _wavy()
     mesh = aftmesh.generate([outer.difference(inner), inner], 0.06)
-    case = fd.FuzzCase("regions", [outer.difference(inner), inner], 0.06, {},
-                       [outer.difference(inner), inner])
+    case = fd.FuzzCase(
+        "regions", [outer.difference(inner), inner], 0.06, {}, [outer.difference(inner), inner]
+    )
     fd.verify(mesh, case, check=checked)
     fixed = aftmesh.generate([outer.difference(inner), inner], 0.06, slide_boundary=False)
     assert dc.edge_keys(mesh.points, mesh.segments) != dc.edge_keys(fixed.points, fixed.segments)
