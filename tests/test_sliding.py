@@ -72,9 +72,9 @@ def test_constraint_line_points_slide_on_the_line(checked):
 
 
 def test_split_points_stay_where_sliding_is_off_or_no_vertex_is_added(checked):
-    """slide_boundary=False, no smoothing and greedy keep the discretization (it then
-    depends only on the boundary and the size; the minimum-angle pass, off here, may
-    split a segment where the interior needs it)."""
+    """slide_boundary=False, no smoothing and greedy keep the discretization, whatever
+    the interior's mesh (the minimum-angle pass, off here, may split a segment where
+    the interior needs it)."""
     poly = _wavy()
     kw = dict(min_angle=None)
     fixed = checked(aftmesh.generate(poly, 0.05, slide_boundary=False, **kw))

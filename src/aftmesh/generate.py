@@ -195,11 +195,10 @@ def generate(
         ``info['smoothing_moves']`` counts the moves.
     slide_boundary : bool
         Let smoothing slide the points that split an input edge along it (default).
-        False keeps them where the boundary's discretization put them, which then
-        depends only on the boundary and the size: two domains meshed apart get the
-        same points on an edge they share (unless the minimum-angle pass splits it).
-        Never with ``greedy`` (its mesh is the CDT of the discretized boundary), and
-        a run in more than one part never slides them, since its parts share them.
+        False keeps them where the boundary's discretization put them, whatever the
+        interior's mesh (the minimum-angle pass may still split a piece).  Never with
+        ``greedy`` (its mesh is the CDT of the discretized boundary), and a run in
+        more than one part never slides them, since its parts share them.
     strategy : Strategy, optional
         Subtasks to plug in (see :class:`aftmesh.aft.Strategy`); the Python loop runs
         then, otherwise the compiled one.
