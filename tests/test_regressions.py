@@ -1007,3 +1007,12 @@ def test_pieces_of_a_line_a_lone_point_was_snapped_onto_stay_within_the_oracle(c
     domain = GeometryCollection([poly, *lines, *points])
     case = fd.FuzzCase("constraints+offset", domain, None, {}, [poly], lines, points)
     assert fd.run_case(case, check=checked) is not None
+
+
+@pytest.mark.parametrize("value", [np.array([]), np.array([1.0]), "yes", 3])
+def test_progress_that_is_not_a_flag_or_a_callable_is_refused_by_name(value):
+    """The long hypothesis profile's test_garbage_option found progress=np.array([])
+    escaping as numpy's "truth value of an empty array is ambiguous" from the
+    progress bar's test, instead of an aftmesh error naming the option."""
+    with pytest.raises(InvalidOptionError, match="progress must be"):
+        aftmesh.generate(box(0, 0, 1, 1), 0.1, progress=value)

@@ -172,6 +172,10 @@ def check_options(
         raise InvalidOptionError(
             f"smooth must be a number of rounds from 0 to {MAX_SMOOTH}, got {smooth!r}"
         )
+    if not (progress is None or isinstance(progress, (bool, np.bool_)) or callable(progress)):
+        raise InvalidOptionError(
+            f"progress must be True, False, None or a callable f(fraction), got {progress!r}"
+        )
     if strategy is not None and not isinstance(strategy, Strategy):
         raise InvalidOptionError(
             f"strategy must be an aftmesh.aft.Strategy (or a subclass), got {strategy!r}"
