@@ -1287,9 +1287,37 @@ def _bounds(polys):
     )
 
 
+def _strictly_outside(polys, p) -> bool:
+    """Whether point p is outside every polygon and on none of their edges, in
+    rational arithmetic."""
+    from fractions import Fraction
+
+    px, py = Fraction(float(p[0])), Fraction(float(p[1]))
+    winding = 0
+    for poly in polys:
+        for part in shapely.get_parts(poly):
+            part = shapely.geometry.polygon.orient(part, 1.0)
+            for ring in [part.exterior, *part.interiors]:
+                c = [(Fraction(x), Fraction(y)) for x, y in np.asarray(ring.coords)[:, :2].tolist()]
+                for (xa, ya), (xb, yb) in zip(c[:-1], c[1:]):
+                    side = (xb - xa) * (py - ya) - (yb - ya) * (px - xa)
+                    within = min(xa, xb) <= px <= max(xa, xb) and min(ya, yb) <= py <= max(ya, yb)
+                    if side == 0 and within:
+                        return False
+                    if ya <= py < yb and side > 0:
+                        winding += 1
+                    elif yb <= py < ya and side < 0:
+                        winding -= 1
+    return winding == 0
+
+
 def _void_points(polys) -> np.ndarray:
     """A point inside each bounded piece of the complement of the polygons: their
-    holes and the gaps enclosed by parts that touch only at corners."""
+    holes and the gaps enclosed by parts that touch only at corners.  A void only a
+    few ulps wide may have no double strictly inside it, and its rounded
+    representative point can then lie on or inside a polygon, where Triangle's hole
+    would eat the domain: such a point is left out (the CDT itself does not depend on
+    the holes, and the check keeps only the mesh's triangles)."""
     union = shapely.union_all(polys)
     x0, y0, x1, y1 = union.bounds
     pad = max(x1 - x0, y1 - y0)
@@ -1297,7 +1325,9 @@ def _void_points(polys) -> np.ndarray:
     pts = []
     for piece in shapely.get_parts(frame.difference(union)):
         if isinstance(piece, Polygon) and not piece.intersects(frame.exterior):
-            pts.append(np.asarray(piece.representative_point().coords)[0])
+            p = np.asarray(piece.representative_point().coords)[0]
+            if _strictly_outside(polys, p):
+                pts.append(p)
     return np.array(pts, dtype=float).reshape(-1, 2)
 
 

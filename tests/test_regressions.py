@@ -1016,3 +1016,27 @@ def test_progress_that_is_not_a_flag_or_a_callable_is_refused_by_name(value):
     progress bar's test, instead of an aftmesh error naming the option."""
     with pytest.raises(InvalidOptionError, match="progress must be"):
         aftmesh.generate(box(0, 0, 1, 1), 0.1, progress=value)
+
+
+def test_oracle_leaves_out_a_hole_seed_that_rounds_onto_the_domain(checked):
+    """Fuzz seed 3802 (extreme+offset): a triangular hole one ulp wide at 3.7e7,
+    whose representative point rounds onto the domain's boundary.  Given to Triangle
+    as a hole seed, it ate the whole domain (one triangle left), and the oracle then
+    reported every mesh triangle as missing from Triangle's CDT.  The mesh was right
+    (all its triangles are in Triangle's CDT without holes); the seed is left out."""
+    outer = [
+        (37498683.763412155, -37498683.763412155),
+        (37498683.76341492, -37498683.763412155),
+        (37498683.76341492, -37498683.763411656),
+        (37498683.763412155, -37498683.763411656),
+    ]
+    hole = [
+        (37498683.763413265, -37498683.76341179),
+        (37498683.76341326, -37498683.76341179),
+        (37498683.763413265, -37498683.7634118),
+    ]
+    poly = Polygon(outer, [hole])
+    for p in fd._void_points([poly]):
+        assert fd._strictly_outside([poly], p)
+    case = fd.FuzzCase("extreme+offset", poly, 6.358823779174462e-07, {"close_factor": 0.0}, [poly])
+    fd.verify(case.call(), case, check=checked)
