@@ -639,6 +639,28 @@ def verify(mesh, case: FuzzCase, check=check_mesh) -> None:
         check_cdt_with_triangle(mesh, _void_points(case.polygons))
 
 
+def _winding_exact(polys, px, py) -> tuple[int, bool]:
+    """The winding number of the polygons' rings around (px, py) (Fractions), and
+    whether the point lies on one of their edges, in rational arithmetic."""
+    from fractions import Fraction
+
+    winding, on_edge = 0, False
+    for poly in polys:
+        for part in shapely.get_parts(poly):
+            part = shapely.geometry.polygon.orient(part, 1.0)
+            for ring in [part.exterior, *part.interiors]:
+                c = [(Fraction(x), Fraction(y)) for x, y in np.asarray(ring.coords)[:, :2].tolist()]
+                for (xa, ya), (xb, yb) in zip(c[:-1], c[1:]):
+                    side = (xb - xa) * (py - ya) - (yb - ya) * (px - xa)
+                    if side == 0 and min(xa, xb) <= px <= max(xa, xb):
+                        on_edge = on_edge or min(ya, yb) <= py <= max(ya, yb)
+                    if ya <= py < yb and side > 0:
+                        winding += 1
+                    elif yb <= py < ya and side < 0:
+                        winding -= 1
+    return winding, on_edge
+
+
 def _exact_winding_inside(poly, corners) -> bool:
     """Whether the exact centroid of a triangle is inside `poly`: the winding number of
     its rings around the point, in rational arithmetic (independent of the even-odd
@@ -647,18 +669,7 @@ def _exact_winding_inside(poly, corners) -> bool:
 
     px = sum(Fraction(float(v)) for v in corners[:, 0]) / 3
     py = sum(Fraction(float(v)) for v in corners[:, 1]) / 3
-    winding = 0
-    for part in shapely.get_parts(poly):
-        rings = [shapely.geometry.polygon.orient(part, 1.0)]
-        for ring in [rings[0].exterior, *rings[0].interiors]:
-            c = [(Fraction(x), Fraction(y)) for x, y in np.asarray(ring.coords)[:, :2].tolist()]
-            for (xa, ya), (xb, yb) in zip(c[:-1], c[1:]):
-                side = (xb - xa) * (py - ya) - (yb - ya) * (px - xa)
-                if ya <= py < yb and side > 0:
-                    winding += 1
-                elif yb <= py < ya and side < 0:
-                    winding -= 1
-    return winding != 0
+    return _winding_exact([poly], px, py)[0] != 0
 
 
 def _check_unsplit(mesh, case: FuzzCase, have: set) -> None:
@@ -1292,23 +1303,8 @@ def _strictly_outside(polys, p) -> bool:
     rational arithmetic."""
     from fractions import Fraction
 
-    px, py = Fraction(float(p[0])), Fraction(float(p[1]))
-    winding = 0
-    for poly in polys:
-        for part in shapely.get_parts(poly):
-            part = shapely.geometry.polygon.orient(part, 1.0)
-            for ring in [part.exterior, *part.interiors]:
-                c = [(Fraction(x), Fraction(y)) for x, y in np.asarray(ring.coords)[:, :2].tolist()]
-                for (xa, ya), (xb, yb) in zip(c[:-1], c[1:]):
-                    side = (xb - xa) * (py - ya) - (yb - ya) * (px - xa)
-                    within = min(xa, xb) <= px <= max(xa, xb) and min(ya, yb) <= py <= max(ya, yb)
-                    if side == 0 and within:
-                        return False
-                    if ya <= py < yb and side > 0:
-                        winding += 1
-                    elif yb <= py < ya and side < 0:
-                        winding -= 1
-    return winding == 0
+    winding, on_edge = _winding_exact(polys, Fraction(float(p[0])), Fraction(float(p[1])))
+    return winding == 0 and not on_edge
 
 
 def _void_points(polys) -> np.ndarray:
