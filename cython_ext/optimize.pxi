@@ -219,7 +219,7 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps) noexcept nogil:
     restore the CDT around it.  A vertex that may not move (see _gather_ring), or
     whose triangles are all shaped better than OPT_SKIP, stays.  Returns 1 if v
     moved, 0 if not, or an error."""
-    cdef int e0 = T.vhe[v], e, k, n
+    cdef int e0 = T.vhe[v], k, n
     cdef Ring R
     cdef double cand[6]
     cdef double q[OPT_RING_CAP]
@@ -254,16 +254,23 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps) noexcept nogil:
         return 0
     T.xy[2 * v] = bx
     T.xy[2 * v + 1] = by
-    e = e0
+    if not _ring_ccw(T, v):
+        T.xy[2 * v] = cx
+        T.xy[2 * v + 1] = cy
+        return 0
+    return _legalize_around(T, v) if swaps else 1
+
+
+cdef bint _ring_ccw(Tri* T, int v) noexcept nogil:
+    """Every triangle around v (none of them a ghost) is counter-clockwise, by the
+    exact orient2d: the test a trial place must pass once the float cost took it."""
+    cdef int e0 = T.vhe[v], e = e0
     while True:
         if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
-            T.xy[2 * v] = cx
-            T.xy[2 * v + 1] = cy
-            return 0
+            return False
         e = T.twin[prv(e)]
         if e == e0:
-            break
-    return _legalize_around(T, v) if swaps else 1
+            return True
 
 
 cdef int _legalize_around(Tri* T, int v) noexcept nogil:

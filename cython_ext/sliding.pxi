@@ -25,8 +25,8 @@
 # that gained a mean radius ratio of 2e-5.  So does a point with more than
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
-# Uses: halfedge.pxd; predicates.pxi (orient2d); optimize.pxi (Ring, _cost_at,
-# _cost_gradient, _candidates, _cost_of_shapes, _better, _legalize_around,
+# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _candidates,
+# _cost_of_shapes, _better, _ring_ccw, _legalize_around,
 # OPT_SKIP, OPT_DESCENT, OPT_RING_CAP, OPT_INVALID); smoothing.pxi (_shape).
 from halfedge cimport *
 from libc.math cimport sqrt, INFINITY
@@ -119,17 +119,6 @@ cdef void _descend_on_line(const Ring* R, const Line* G, double worst0, double* 
             by[0] = y
             best[0] = c
             return
-
-
-cdef bint _ring_ccw(Tri* T, int v) noexcept nogil:
-    """Every triangle around v (none of them a ghost) is counter-clockwise."""
-    cdef int e0 = T.vhe[v], e = e0
-    while True:
-        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
-            return False
-        e = T.twin[prv(e)]
-        if e == e0:
-            return True
 
 
 cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
