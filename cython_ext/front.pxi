@@ -21,12 +21,12 @@ from halfedge cimport *
 from aft cimport Aft, QueueItem
 from libc.math cimport sqrt, floor, log2, fabs
 from libc.stdlib cimport malloc, free
-from libc.string cimport memset
+from libc.string cimport memset, memcpy
+from libc.stdint cimport uint64_t
 
 # Tuning constants of the compiled loop (each with the reason for its value).
 # Get_next_edge compares lengths in classes of 2**(1/8) (about 9 %): the key is
-# floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(|E|^2)), i.e. eighths of an octave of |E|.
-cdef double LENGTH_CLASSES_PER_OCTAVE_SQ = 4.0
+# floor(4 log2(|E|^2)), i.e. eighths of an octave of |E| (_quarter_octaves).
 cdef enum:
     # steps between two looks at Python's signal handlers and the progress callable:
     # rare enough to cost nothing, frequent enough for Ctrl-C to answer within ~10 ms
@@ -136,6 +136,39 @@ cdef void queue_clear(Aft* A) noexcept nogil:
     A.low_class = QUEUE_CLASSES
 
 
+# 2**(1/4), 2**(1/2), 2**(3/4): the mantissa's class boundaries (_quarter_octaves)
+cdef double QUARTER_OCTAVE_1 = 1.189207115002721
+cdef double QUARTER_OCTAVE_2 = 1.4142135623730951
+cdef double QUARTER_OCTAVE_3 = 1.681792830507429
+# a mantissa this close to a class boundary (or to 1 or 2) is classed by log2 itself:
+# there its rounding, not the exact value, decides the class (a square one ulp below
+# 2**-4 lands in 2**-4's class, one ulp below 2**-2 in the class below), and far
+# beyond log2's error (an ulp of the result) everywhere else the two agree
+cdef double QUARTER_OCTAVE_MARGIN = 1e-9
+
+
+cdef inline double _quarter_octaves(double s) noexcept nogil:
+    # floor(4 log2 s), as floor(4.0 * log2(s)) gives it, from the bits of s where no
+    # rounding can matter: a normal double is m 2**e with m in [1, 2), and the class
+    # of m is its place among the 2**(k/4).  Every queued edge needs one, and this
+    # costs far less than a log2 call.
+    cdef uint64_t bits
+    cdef int ex
+    cdef double m
+    memcpy(&bits, &s, sizeof(double))
+    ex = <int> ((bits >> 52) & 0x7ff)
+    bits = (bits & 0x000fffffffffffffULL) | 0x3ff0000000000000ULL
+    memcpy(&m, &bits, sizeof(double))
+    if (ex == 0 or ex == 0x7ff or s < 0.0
+            or m < 1.0 + QUARTER_OCTAVE_MARGIN or m > 2.0 - QUARTER_OCTAVE_MARGIN
+            or fabs(m - QUARTER_OCTAVE_1) < QUARTER_OCTAVE_MARGIN
+            or fabs(m - QUARTER_OCTAVE_2) < QUARTER_OCTAVE_MARGIN
+            or fabs(m - QUARTER_OCTAVE_3) < QUARTER_OCTAVE_MARGIN):
+        return floor(4.0 * log2(s))
+    return <double> (4 * (ex - 1023) + (m > QUARTER_OCTAVE_1) + (m > QUARTER_OCTAVE_2)
+                     + (m > QUARTER_OCTAVE_3))
+
+
 cdef inline int _length_class(Aft* A, double dx, double dy) noexcept nogil:
     # Lengths are compared in classes about 9 % wide (eighths of an octave of the
     # length), oldest first within a class.  With exact lengths, edges a
@@ -144,9 +177,9 @@ cdef inline int _length_class(Aft* A, double dx, double dy) noexcept nogil:
     # classes make the fronts of equal size advance together, layer by layer.
     cdef double key
     if A.order == ORDER_SHORTEST:
-        key = floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(dx * dx + dy * dy))
+        key = _quarter_octaves(dx * dx + dy * dy)
     elif A.order == ORDER_LONGEST:
-        key = -floor(LENGTH_CLASSES_PER_OCTAVE_SQ * log2(dx * dx + dy * dy))
+        key = -_quarter_octaves(dx * dx + dy * dy)
     else:
         return QUEUE_CLASS_BOUND + 1
     if key < -QUEUE_CLASS_BOUND:

@@ -19,6 +19,8 @@
 
 from __future__ import annotations
 
+import math
+
 import domain_cases as dc
 import numpy as np
 import pytest
@@ -498,6 +500,24 @@ def test_get_next_edge_order_is_length_class_then_age(order):
     assert np.all(np.diff(classes) >= 0)
     for c in np.unique(classes):
         assert np.all(np.diff(edges[classes == c]) > 0)
+
+
+@pytest.mark.parametrize("k", [-7, -4, -2, 0, 3])
+def test_length_classes_are_log2s_at_the_class_boundaries(k):
+    """The queue's length class is floor(4 log2 |E|^2) as the C library's log2 rounds
+    it, also within a rounding error of a class boundary, where the rounding and not
+    the exact value decides (the kernel reads the class from the bits of |E|^2
+    elsewhere).  Rectangles whose sides are a power of two, or 2**(1/8) times one, and
+    the doubles beside it: the first popped edges come in (class, age) order."""
+    for base in (2.0**k, 2.0 ** (k + 0.125)):
+        for w in (np.nextafter(base, 0), base, np.nextafter(base, np.inf)):
+            for h in (np.nextafter(base, 0), base):
+                drain = DrainQueue()
+                rect = Polygon([(0, 0), (w, 0), (w, h), (0, h)])
+                with pytest.raises(_Drained):
+                    aftmesh.generate(rect, 100.0 * base, strategy=drain)
+                keys = [(math.floor(4 * math.log2(q)), e) for q, e in drain.popped[:4]]
+                assert keys == sorted(keys)
 
 
 def test_seams_where_two_lattices_meet_stay_narrow(checked):
