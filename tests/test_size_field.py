@@ -183,3 +183,77 @@ def test_compiled_chains_equal_the_numpy_chains():
         assert len(fast[1]) > len(seg)
         for x, y in zip(fast, slow):
             assert np.array_equal(x, y)
+
+
+def _numpy_round(keys, passed, n, xy, size, u, thin):
+    """One round of the callable's sampling as numpy states it (the definition the
+    kernel's edges_to_sample and midpoints_to_insert compute, resolve.pxi)."""
+    from aftmesh.sizing import RESOLVE_COARSEST, RESOLVE_SPAN, RESOLVE_TOLERANCE
+
+    keys = keys[~np.isin(keys, passed)]
+    a, b = keys // n, keys % n
+    mid = 0.5 * (xy[a] + xy[b])
+    length = np.linalg.norm(xy[b] - xy[a], axis=1)
+    um = size(mid[:, 0], mid[:, 1])
+    miss = np.abs(0.5 * (u[a] + u[b]) - um) > RESOLVE_TOLERANCE * um
+    bad = (miss & (length > RESOLVE_SPAN * um)) | (length > RESOLVE_COARSEST * um)
+    at = np.flatnonzero(bad)
+    level = np.floor(np.log2(length[at]))
+    cell = thin * np.exp2(level)
+    low = mid[at].min(axis=0) if len(at) else np.zeros(2)
+    ix = np.floor((mid[at, 0] - low[0]) / cell)
+    iy = np.floor((mid[at, 1] - low[1]) / cell)
+    order = np.lexsort((iy, ix, level))
+    first = np.ones(len(at), dtype=bool)
+    first[1:] = np.diff(level[order]) != 0
+    first[1:] |= (np.diff(ix[order]) != 0) | (np.diff(iy[order]) != 0)
+    return keys, mid, um, np.sort(np.concatenate([passed, keys[~bad]])), np.sort(at[order[first]])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_kernel_sampling_round_is_the_numpy_round(seed):
+    """A round of the size callable's sampling in the kernel (which edges to sample,
+    which midpoints to insert, what passed) gives exactly the numpy definition's
+    arrays, on a random background with some edges passed before."""
+    from aftmesh import _kernel
+    from aftmesh.sizing import RESOLVE_COARSEST, RESOLVE_SPAN, RESOLVE_THIN, RESOLVE_TOLERANCE
+
+    rng = np.random.default_rng(seed)
+    xy = rng.uniform(-3, 7, (300, 2))
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(np.arange(len(xy), dtype=np.int32))
+    n = len(xy) + 10
+    all_keys = tri.edge_keys(n)
+    passed = np.sort(rng.choice(all_keys, len(all_keys) // 3, replace=False))
+
+    def size(x, y):
+        return 0.05 + 0.3 * np.abs(np.sin(x)) * (1 + y * y)
+
+    u = size(xy[:, 0], xy[:, 1])
+    keys0, mid0, um, passed0, at0 = _numpy_round(all_keys, passed, n, xy, size, u, RESOLVE_THIN)
+    keys, ends, mid, length = _kernel.edges_to_sample(all_keys, passed, n, xy)
+    assert np.array_equal(keys, keys0) and np.array_equal(mid, mid0)
+    assert np.array_equal(ends, np.c_[keys // n, keys % n])
+    got_passed, at = _kernel.midpoints_to_insert(
+        keys, ends, mid, length, size(mid[:, 0], mid[:, 1]), u, passed,
+        RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
+    )  # fmt: skip
+    assert np.array_equal(got_passed, passed0) and np.array_equal(at, at0)
+    assert 0 < len(at) < len(keys)
+
+
+def test_kernel_sampling_round_refuses_vertices_it_has_no_data_for():
+    """An edge key or end beyond the points or sizes given is a ValueError naming
+    the count, not a read past the arrays."""
+    from aftmesh import _kernel
+
+    xy = np.zeros((3, 2))
+    with pytest.raises(ValueError, match="3 points"):
+        _kernel.edges_to_sample(np.array([5], np.int64), np.zeros(0, np.int64), 10, xy)
+    ends = np.array([[0, 7]], dtype=np.int64)
+    one = np.ones(1)
+    with pytest.raises(ValueError, match="3 sizes"):
+        _kernel.midpoints_to_insert(
+            np.array([7], np.int64), ends, np.zeros((1, 2)), one, one, np.ones(3),
+            np.zeros(0, np.int64), 0.2, 1.0, 8.0, 0.5,
+        )  # fmt: skip

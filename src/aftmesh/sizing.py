@@ -267,65 +267,35 @@ def _box_corners(bounds) -> np.ndarray:
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
 
 
-def _not_in(keys: np.ndarray, passed: np.ndarray) -> np.ndarray:
-    """Which of the sorted keys are not in the sorted array passed."""
-    if len(passed) == 0:
-        return np.ones(len(keys), dtype=bool)
-    at = np.minimum(np.searchsorted(passed, keys), len(passed) - 1)
-    return passed[at] != keys
-
-
-def _one_per_cell(mid: np.ndarray, length: np.ndarray) -> np.ndarray:
-    """Which midpoints to insert: the first in each square cell of side
-    RESOLVE_THIN * 2**k, k = floor(log2(length)), among the edges of that k."""
-    level = np.floor(np.log2(length))
-    cell = RESOLVE_THIN * np.exp2(level)
-    low = mid.min(axis=0)
-    ix = np.floor((mid[:, 0] - low[0]) / cell)
-    iy = np.floor((mid[:, 1] - low[1]) / cell)
-    order = np.lexsort((iy, ix, level))  # stable: each cell's first midpoint leads
-    lv, x, y = level[order], ix[order], iy[order]
-    first = np.ones(len(mid), dtype=bool)
-    first[1:] = (lv[1:] != lv[:-1]) | (x[1:] != x[:-1]) | (y[1:] != y[:-1])
-    keep = np.zeros(len(mid), dtype=bool)
-    keep[order[first]] = True
-    return keep
-
-
 def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
     """Sample the callable at the midpoints of the background's edges, round by round
     (one call each), and split the edges where interpolating between their ends
     misses it (RESOLVE_TOLERANCE) while longer than the size there (RESOLVE_SPAN), or
-    where they are longer than RESOLVE_COARSEST sizes, inserting one midpoint per
-    cell of _one_per_cell among those of similar length.  An edge that passed once is
-    not sampled again while it lasts."""
+    where they are longer than RESOLVE_COARSEST sizes, inserting the first midpoint
+    in each square cell of side RESOLVE_THIN 2**k among the edges of length in
+    [2**k, 2**(k+1)).  An edge that passed once is not sampled again while it lasts.
+    The kernel does each round's arithmetic (cython_ext/resolve.pxi)."""
     passed = np.zeros(0, dtype=np.int64)  # sorted edge keys
     calls = 0
     n_max = len(pts) + RESOLVE_EVALUATIONS
     for _ in range(RESOLVE_ROUNDS):
-        keys = tri.edge_keys(n_max)
-        keys = keys[_not_in(keys, passed)]
+        keys, ends, mid, length = _kernel.edges_to_sample(tri.edge_keys(n_max), passed, n_max, pts)
         if len(keys) == 0 or calls + len(keys) > RESOLVE_EVALUATIONS:
             break
-        edges = np.column_stack([keys // n_max, keys % n_max])
-        a, b = pts[edges[:, 0]], pts[edges[:, 1]]
-        mid = 0.5 * (a + b)
         um = _evaluate(size, mid[:, 0], mid[:, 1])
         calls += len(keys)
         _check_resolution(um, mid[:, 0], mid[:, 1], bounds, "the size callable gave")
-        length = np.linalg.norm(b - a, axis=1)
-        miss = np.abs(0.5 * (u[edges[:, 0]] + u[edges[:, 1]]) - um) > RESOLVE_TOLERANCE * um
-        bad = (miss & (length > RESOLVE_SPAN * um)) | (length > RESOLVE_COARSEST * um)
-        passed = np.sort(np.concatenate([passed, keys[~bad]]))
-        if not bad.any():
+        passed, at = _kernel.midpoints_to_insert(
+            keys, ends, mid, length, um, u, passed,
+            RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
+        )  # fmt: skip
+        if len(at) == 0:
             break
-        at = np.flatnonzero(bad)
-        at = at[_one_per_cell(mid[at], length[at])]
-        order = brio_order(mid[at])  # short walks between consecutive insertions
-        new, u_new = np.ascontiguousarray(mid[at][order]), um[at][order]
+        at = at[brio_order(mid[at])]  # short walks between consecutive insertions
+        new = np.ascontiguousarray(mid[at])
         tri.add_points(new)
         pts = np.concatenate([pts, new])
-        u = np.concatenate([u, u_new])
+        u = np.concatenate([u, um[at]])
     return pts, u
 
 
