@@ -367,12 +367,12 @@ cdef class Triangulation:
         if n < self.T.nv:
             raise ValueError(f"edge keys need n >= {self.T.nv} (the vertex count), got {n}")
         keys_arr = np.empty(3 * max(self.T.nt, 1), dtype=np.int64)
+        ring_arr = np.empty(max(self.T.nv, 1), dtype=np.int32)
         cdef int64_t[::1] keys = keys_arr
+        cdef int32_t[::1] ring = ring_arr
         with nogil:
-            m = finite_edge_keys(&self.T, n, &keys[0])
-        keys_arr = keys_arr[:m]
-        keys_arr.sort()
-        return keys_arr
+            m = finite_edge_keys(&self.T, n, &keys[0], &ring[0])
+        return keys_arr[:m]
 
     def insert_segments(self, const int32_t[:, ::1] segments, int flag=E_SEGMENT,
                         int first_id=0):

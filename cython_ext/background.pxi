@@ -3,16 +3,20 @@
 # its finite triangles, and the boundary's sizes spread over its edges at the
 # gradation rate, for one call of the def layer (background_field) that holds the
 # GIL only to make its arrays (src/aftmesh/sizing.py, make_size_field).  The pieces
-# also serve Triangulation.finite_triangles and limit_gradation_mesh.
+# also serve Triangulation.finite_triangles, Triangulation.edge_keys and
+# limit_gradation_mesh.
 #
 # Uses: triangulation.pxi (Tri, tri_init, insert_points), ordering.pxi
 # (hilbert_keys_into), inputs.pxi (stable_order), sizing.pxi (limit_gradation_graph).
-from libc.stdlib cimport malloc, free
+from libc.stdlib cimport malloc, free, qsort
 from libc.math cimport INFINITY, isfinite
 
 cdef enum:
     # the Hilbert grid of _order.brio_order (hilbert_keys' default): 2**16 cells a side
     BRIO_HILBERT_BITS = 16
+    # finite_edge_keys sorts a vertex's neighbours in place up to this many (most have
+    # about six), and with qsort beyond (a box corner can have thousands)
+    KEYS_INSERTION_SORT_MAX = 32
 
 
 cdef int finite_index(Tri* T, int32_t* index) noexcept nogil:
@@ -40,25 +44,52 @@ cdef void finite_into(Tri* T, const int32_t* index, int32_t* tv, int32_t* nb) no
                 nb[3 * index[t] + k] = index[T.twin[3 * t + (k + 1) % 3] // 3]
 
 
-cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys) noexcept nogil:
+cdef inline bint _finite_live(Tri* T, int t) noexcept nogil:
+    return T.tstate[t] != T_FREE and not is_ghost(T, t)
+
+
+cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys,
+                              int32_t* ring) noexcept nogil:
     """keys[i] = a n + b (a < b) for each edge a-b of the live finite triangles, once
-    (keys holds 3 T.nt); returns how many.  Unsorted: in half-edge order."""
-    cdef int t, k, e, te
-    cdef int64_t a, b, m = 0
-    for t in range(T.nt):
-        if T.tstate[t] == T_FREE or is_ghost(T, t):
+    and in increasing order (keys holds 3 T.nt; ring, scratch for one vertex's
+    neighbours, holds T.nv); returns how many.  Vertex by vertex, the larger ends of
+    its edges sorted: the order needs no sort of the whole list."""
+    cdef int a, e0, e, b, cnt, i, j
+    cdef int32_t x
+    cdef int64_t m = 0
+    for a in range(T.nv):
+        e0 = T.vhe[a]
+        if e0 < 0:
             continue
-        for k in range(3):
-            e = 3 * t + k
-            te = T.twin[e]
-            # an edge shared by two finite triangles is listed from its larger half-edge
-            if te > e and T.tstate[te // 3] != T_FREE and not is_ghost(T, te // 3):
-                continue
-            a = T.tv[e]
+        cnt = 0
+        e = e0
+        while True:     # each half-edge leaving a, once
             b = T.tv[nxt(e)]
-            keys[m] = a * n + b if a < b else b * n + a
+            if b > a and (_finite_live(T, e // 3) or _finite_live(T, T.twin[e] // 3)):
+                ring[cnt] = b
+                cnt += 1
+            e = T.twin[prv(e)]
+            if e == e0:
+                break
+        if cnt > KEYS_INSERTION_SORT_MAX:
+            qsort(ring, cnt, sizeof(int32_t), _int32_order)
+        else:
+            for i in range(1, cnt):
+                x = ring[i]
+                j = i - 1
+                while j >= 0 and ring[j] > x:
+                    ring[j + 1] = ring[j]
+                    j -= 1
+                ring[j + 1] = x
+        for i in range(cnt):
+            keys[m] = a * n + ring[i]
             m += 1
     return m
+
+
+cdef int _int32_order(const void* p, const void* q) noexcept nogil:
+    cdef int32_t a = (<const int32_t*> p)[0], b = (<const int32_t*> q)[0]
+    return -1 if a < b else (1 if a > b else 0)
 
 
 cdef int unused_to_inf(int n, int nt, const int32_t* tv, double* g) noexcept nogil:

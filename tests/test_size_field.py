@@ -257,3 +257,26 @@ def test_kernel_sampling_round_refuses_vertices_it_has_no_data_for():
             np.array([7], np.int64), ends, np.zeros((1, 2)), one, one, np.ones(3),
             np.zeros(0, np.int64), 0.2, 1.0, 8.0, 0.5,
         )  # fmt: skip
+
+
+@pytest.mark.parametrize("n_points", [4, 60, 2000])
+def test_edge_keys_are_the_finite_triangles_edges_sorted(n_points):
+    """Triangulation.edge_keys lists every edge of the finite triangles once, as a n + b
+    with a < b, in increasing order (built vertex by vertex, without a sort of the
+    whole list), also with duplicate points (merged, in no triangle) and a vertex of
+    many neighbours (the centre of a fan)."""
+    from aftmesh import _kernel
+
+    rng = np.random.default_rng(n_points)
+    t = np.linspace(0, 2 * np.pi, n_points, endpoint=False)
+    r, s = rng.uniform(1.5, 3.0, n_points), rng.uniform(0, 2 * np.pi, n_points)
+    outside = np.c_[r * np.cos(s), r * np.sin(s)]  # leaves the fan around (0, 0) whole
+    xy = np.concatenate([[[0.0, 0.0]], np.c_[np.cos(t), np.sin(t)], outside])
+    xy = np.concatenate([xy, xy[:3]])
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(np.arange(len(xy), dtype=np.int32))
+    n = len(xy) + 5
+    tv, _ = tri.finite_triangles()
+    e = np.sort(np.concatenate([tv[:, [0, 1]], tv[:, [1, 2]], tv[:, [2, 0]]]), axis=1)
+    assert np.array_equal(tri.edge_keys(n), np.unique(e[:, 0].astype(np.int64) * n + e[:, 1]))
+    assert (e == 0).sum() >= n_points - 1  # the fan's centre: one neighbour per rim point
