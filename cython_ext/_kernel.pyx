@@ -1226,10 +1226,12 @@ def edges_to_sample(const int64_t[::1] keys, const int64_t[::1] passed, int64_t 
     sizing.py's _resolve_callable (resolve.pxi)."""
     cdef int64_t m = keys.shape[0], k, i, nv = xy.shape[0]
     cdef int64_t ok = 1
+    if n <= 0:
+        raise ValueError(f"edge keys need a positive n, got {n}")
     out_arr = np.empty(m, dtype=np.int64)
     cdef int64_t[::1] out = out_arr
-    if m == 0 or n <= 0:
-        return out_arr[:0], np.empty((0, 2), np.int64), np.empty((0, 2)), np.empty(0)
+    if m == 0:
+        return out_arr, np.empty((0, 2), np.int64), np.empty((0, 2)), np.empty(0)
     with nogil:
         k = keys_not_in(&keys[0], m, &passed[0] if passed.shape[0] else NULL,
                         passed.shape[0], &out[0])

@@ -243,13 +243,15 @@ def test_kernel_sampling_round_is_the_numpy_round(seed):
 
 
 def test_kernel_sampling_round_refuses_vertices_it_has_no_data_for():
-    """An edge key or end beyond the points or sizes given is a ValueError naming
-    the count, not a read past the arrays."""
+    """An edge key or end beyond the points or sizes given, or a key base that is not
+    positive, is a ValueError naming the count, not a read past the arrays."""
     from aftmesh import _kernel
 
     xy = np.zeros((3, 2))
     with pytest.raises(ValueError, match="3 points"):
         _kernel.edges_to_sample(np.array([5], np.int64), np.zeros(0, np.int64), 10, xy)
+    with pytest.raises(ValueError, match="positive n"):
+        _kernel.edges_to_sample(np.array([5], np.int64), np.zeros(0, np.int64), 0, xy)
     ends = np.array([[0, 7]], dtype=np.int64)
     one = np.ones(1)
     with pytest.raises(ValueError, match="3 sizes"):
