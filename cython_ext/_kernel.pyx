@@ -367,9 +367,8 @@ cdef class Triangulation:
         if n < self.T.nv:
             raise ValueError(f"edge keys need n >= {self.T.nv} (the vertex count), got {n}")
         keys_arr = np.empty(3 * max(self.T.nt, 1), dtype=np.int64)
-        ring_arr = np.empty(max(self.T.nv, 1), dtype=np.int32)
-        cdef int64_t[::1] keys = keys_arr
-        cdef int32_t[::1] ring = ring_arr
+        ring_arr = np.empty(max(self.T.nv, 1), dtype=np.int64)
+        cdef int64_t[::1] keys = keys_arr, ring = ring_arr
         with nogil:
             m = finite_edge_keys(&self.T, n, &keys[0], &ring[0])
         return keys_arr[:m]
@@ -1266,12 +1265,12 @@ def midpoints_to_insert(const int64_t[::1] keys, const int64_t[:, ::1] ends,
     cdef bint ok = True
     if not (ends.shape[0] == mid.shape[0] == length.shape[0] == um.shape[0] == m):
         raise ValueError("keys, ends, mid, length and um differ in length")
+    if m == 0:
+        return np.array(passed, dtype=np.int64), np.zeros(0, dtype=np.int64)
     bad_arr = np.empty(m, dtype=np.int64)
     good_arr = np.empty(m, dtype=np.int64)
     merged_arr = np.empty(m + passed.shape[0], dtype=np.int64)
     cdef int64_t[::1] bad = bad_arr, good = good_arr, merged = merged_arr
-    if m == 0:
-        return np.array(passed, dtype=np.int64), np.zeros(0, dtype=np.int64)
     cdef const int64_t* pass_p = &passed[0] if passed.shape[0] else NULL
     cdef int64_t* good_p = &good[0]
     cdef int64_t* bad_p = &bad[0]

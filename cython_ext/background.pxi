@@ -49,13 +49,13 @@ cdef inline bint _finite_live(Tri* T, int t) noexcept nogil:
 
 
 cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys,
-                              int32_t* ring) noexcept nogil:
+                              int64_t* ring) noexcept nogil:
     """keys[i] = a n + b (a < b) for each edge a-b of the live finite triangles, once
     and in increasing order (keys holds 3 T.nt; ring, scratch for one vertex's
     neighbours, holds T.nv); returns how many.  Vertex by vertex, the larger ends of
     its edges sorted: the order needs no sort of the whole list."""
     cdef int a, e0, e, b, cnt, i, j
-    cdef int32_t x
+    cdef int64_t x
     cdef int64_t m = 0
     for a in range(T.nv):
         e0 = T.vhe[a]
@@ -72,7 +72,7 @@ cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys,
             if e == e0:
                 break
         if cnt > KEYS_INSERTION_SORT_MAX:
-            qsort(ring, cnt, sizeof(int32_t), _int32_order)
+            qsort(ring, cnt, sizeof(int64_t), int64_order)
         else:
             for i in range(1, cnt):
                 x = ring[i]
@@ -87,8 +87,9 @@ cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys,
     return m
 
 
-cdef int _int32_order(const void* p, const void* q) noexcept nogil:
-    cdef int32_t a = (<const int32_t*> p)[0], b = (<const int32_t*> q)[0]
+cdef int int64_order(const void* p, const void* q) noexcept nogil:
+    # qsort's comparison of int64 values (also resolve.pxi's)
+    cdef int64_t a = (<const int64_t*> p)[0], b = (<const int64_t*> q)[0]
     return -1 if a < b else (1 if a > b else 0)
 
 

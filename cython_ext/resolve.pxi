@@ -6,7 +6,7 @@
 #
 # Edges are int64 keys a n + b (a < b), sorted, as Triangulation.edge_keys gives them.
 #
-# Uses: nothing of the kernel (libc only).
+# Uses: background.pxi (int64_order).
 from libc.math cimport floor, log2, ldexp, fabs, sqrt
 from libc.stdlib cimport qsort
 from libc.stdint cimport int64_t
@@ -115,13 +115,8 @@ cdef int64_t one_per_cell(const double* mid, const double* length, const int64_t
                 or cells[i].iy != cells[i - 1].iy):
             out[kept] = cells[i].index
             kept += 1
-    qsort(out, kept, sizeof(int64_t), _index_order)
+    qsort(out, kept, sizeof(int64_t), int64_order)
     return kept
-
-
-cdef int _index_order(const void* p, const void* q) noexcept nogil:
-    cdef int64_t a = (<const int64_t*> p)[0], b = (<const int64_t*> q)[0]
-    return -1 if a < b else (1 if a > b else 0)
 
 
 cdef bint too_coarse(double ua, double ub, double um, double length, double tolerance,
