@@ -11,9 +11,10 @@
 # * its place is computed on the line of its chain's ends (chains.pxi), a + t (b - a),
 #   as every split point is, so it stays within the rounding of its input segment
 #   (ARCHITECTURE.md's rounding rules);
-# * the candidate places are optimize.pxi's, projected on that line, then a descent
-#   along it, judged by optimize.pxi's cost over the meshed triangles around it (one
-#   side of a boundary segment, both sides of an interface);
+# * the places tried are optimize.pxi's, restricted to that line: the neighbours' mean
+#   projected on it, then steps along it, judged by optimize.pxi's cost over the
+#   meshed triangles around it (one side of a boundary segment, both sides of an
+#   interface);
 # * a place is kept only when it lowers that cost without lowering the worst shape,
 #   and every triangle around the point, outside the domain too, stays
 #   counter-clockwise (exact orient2d); then Lawson flips restore the CDT around it.
@@ -25,9 +26,9 @@
 # that gained a mean radius ratio of 2e-5.  So does a point with more than
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
-# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _candidates,
-# _cost_of_shapes, _better, _ring_ccw, _legalize_around,
-# OPT_SKIP, OPT_DESCENT, OPT_RING_CAP, OPT_INVALID); smoothing.pxi (_shape).
+# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
+# _cost_of_shapes, _better, _ring_ccw, _legalize_around, OPT_SKIP, OPT_DESCENT,
+# OPT_DESCENT_STEPS, OPT_RING_CAP, OPT_INVALID); smoothing.pxi (_shape).
 from halfedge cimport *
 from libc.math cimport sqrt, INFINITY
 
@@ -101,34 +102,41 @@ cdef inline double _param(const Line* G, double x, double y) noexcept nogil:
 
 cdef void _descend_on_line(const Ring* R, const Line* G, double worst0, double* bt,
                            double* bx, double* by, double* best) noexcept nogil:
-    """Steps from t = bt along the line against the cost's slope there, the longest
-    that improves first (optimize.pxi's _descend, restricted to the line)."""
+    """optimize.pxi's _descend restricted to the line: up to OPT_DESCENT_STEPS steps
+    along it against the cost's slope, each the longest that improves."""
     cdef double gx, gy, slope, c, x, y, t
-    cdef int k
-    _cost_gradient(R, bx[0], by[0], &gx, &gy)
-    slope = gx * G.dx + gy * G.dy
-    if not (slope != 0.0 and slope > -INFINITY and slope < INFINITY):
-        return                      # flat, or at an invalid place
-    for k in range(4):
-        t = bt[0] - (OPT_DESCENT[k] * G.step if slope > 0 else -OPT_DESCENT[k] * G.step)
-        _on_line(G, t, &x, &y)
-        c = _cost_at(R, x, y, worst0)
-        if _better(c, best[0]):
-            bt[0] = t
-            bx[0] = x
-            by[0] = y
-            best[0] = c
+    cdef int k, it, k0 = 0
+    cdef bint stepped
+    for it in range(OPT_DESCENT_STEPS):
+        _cost_gradient(R, bx[0], by[0], &gx, &gy)
+        slope = gx * G.dx + gy * G.dy
+        if not (slope != 0.0 and slope > -INFINITY and slope < INFINITY):
+            return                      # flat, or at an invalid place
+        stepped = False
+        for k in range(k0, 4):
+            t = bt[0] - (OPT_DESCENT[k] * G.step if slope > 0 else -OPT_DESCENT[k] * G.step)
+            _on_line(G, t, &x, &y)
+            c = _cost_at(R, x, y, worst0)
+            if _better(c, best[0]):
+                bt[0] = t
+                bx[0] = x
+                by[0] = y
+                best[0] = c
+                stepped = True
+                k0 = k
+                break
+        if not stepped:
             return
 
 
 cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
     """Move split point v along the line of its chain's ends a, b to the best of the
-    candidate places (see the top of this file); then, with `swaps`, restore the CDT
+    places tried (see the top of this file); then, with `swaps`, restore the CDT
     around it.  Returns 1 if v moved, 0 if not, or an error."""
-    cdef int s = _fan_start(T, v), n, k
+    cdef int s = _fan_start(T, v), n
     cdef Ring R
     cdef Line G
-    cdef double cand[6]
+    cdef double lap[2]
     cdef double q[OPT_RING_CAP]
     cdef double worst0, L, c, best, x, y, t, bt, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
@@ -147,24 +155,19 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
     G.L2 = G.dx * G.dx + G.dy * G.dy
     if not G.L2 > 0.0:
         return 0
-    _candidates(&R, q, P(T, v), cand, &L)
+    _laplacian(&R, P(T, v), lap, &L)
     G.step = L / sqrt(G.L2)
     bt = _param(&G, cx, cy)
     bx = cx
     by = cy
-    for k in range(4):
-        if k < 2:
-            t = _param(&G, cand[2 * k], cand[2 * k + 1])
-        else:
-            c = 0.25 if k == 2 else 0.5
-            t = _param(&G, cx + c * (cand[4] - cx), cy + c * (cand[5] - cy))
-        _on_line(&G, t, &x, &y)
-        c = _cost_at(&R, x, y, worst0)
-        if _better(c, best):
-            best = c
-            bt = t
-            bx = x
-            by = y
+    t = _param(&G, lap[0], lap[1])
+    _on_line(&G, t, &x, &y)
+    c = _cost_at(&R, x, y, worst0)
+    if _better(c, best):
+        best = c
+        bt = t
+        bx = x
+        by = y
     _descend_on_line(&R, &G, worst0, &bt, &bx, &by, &best)
     if bx == cx and by == cy:
         return 0

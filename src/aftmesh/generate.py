@@ -180,10 +180,9 @@ def generate(
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
-        equilateral, a few places (the mean of its neighbours, the optimal-Delaunay
-        point, steps towards its worst triangle's ideal apex, then a gradient step)
-        and moves it to the one that lowers the sum of 1/shape^2 of its triangles
-        without making the worst of them worse, keeping every triangle
+        equilateral, the mean of its neighbours and then up to four steps along
+        the gradient, and moves it to the place that lowers the sum of 1/shape^2
+        of its triangles without making the worst of them worse, keeping every triangle
         counter-clockwise (exact); edge swaps around it then restore the constrained
         Delaunay property.  With ``slide_boundary``, a point that splits an input
         edge is judged the same way, but only along its input edge, so the domain
