@@ -88,7 +88,7 @@ cdef int64_t finite_edge_keys(Tri* T, int64_t n, int64_t* keys,
 
 
 cdef int int64_order(const void* p, const void* q) noexcept nogil:
-    # qsort's comparison of int64 values (also resolve.pxi's)
+    # qsort's comparison of int64 values
     cdef int64_t a = (<const int64_t*> p)[0], b = (<const int64_t*> q)[0]
     return -1 if a < b else (1 if a > b else 0)
 

@@ -6,7 +6,7 @@
 #
 # Edges are int64 keys a n + b (a < b), sorted, as Triangulation.edge_keys gives them.
 #
-# Uses: background.pxi (int64_order).
+# Uses: nothing else of the kernel.
 from libc.math cimport floor, log2, ldexp, fabs, sqrt
 from libc.stdlib cimport qsort
 from libc.stdint cimport int64_t
@@ -72,7 +72,7 @@ cdef int64_t merge_sorted(const int64_t* a, int64_t na, const int64_t* b, int64_
 cdef struct CellKey:
     # a midpoint's thinning cell: its length's octave, then the cell's column and row
     double level, ix, iy
-    int64_t index       # the midpoint's position among the edges: first wins a tie
+    int64_t index       # the midpoint's place in at (increasing): first wins a tie
 
 
 cdef int _cell_order(const void* p, const void* q) noexcept nogil:
@@ -92,7 +92,8 @@ cdef int64_t one_per_cell(const double* mid, const double* length, const int64_t
     """Of the midpoints at[0..m) (increasing), the first in each square cell of side
     thin 2**k, k = floor(log2(length)), among those of the same k; the cells are
     counted from the smallest coordinates of the m midpoints.  The kept indices go to
-    out in increasing order; returns how many.  cells holds m entries."""
+    out (m entries, not at) in increasing order; returns how many.  cells holds m
+    entries."""
     cdef int64_t i, j, kept = 0
     cdef double lowx, lowy, cell
     if m == 0:
@@ -108,14 +109,20 @@ cdef int64_t one_per_cell(const double* mid, const double* length, const int64_t
         cell = thin * ldexp(1.0, <int> cells[i].level)
         cells[i].ix = floor((mid[2 * j] - lowx) / cell)
         cells[i].iy = floor((mid[2 * j + 1] - lowy) / cell)
-        cells[i].index = j
+        cells[i].index = i
     qsort(cells, m, sizeof(CellKey), _cell_order)
+    # out[i] first flags whether at[i] leads its cell, then the flagged are packed in
+    # place, in at's order (no second sort)
+    for i in range(m):
+        out[i] = 0
     for i in range(m):
         if (i == 0 or cells[i].level != cells[i - 1].level or cells[i].ix != cells[i - 1].ix
                 or cells[i].iy != cells[i - 1].iy):
-            out[kept] = cells[i].index
+            out[cells[i].index] = 1
+    for i in range(m):
+        if out[i]:
+            out[kept] = at[i]
             kept += 1
-    qsort(out, kept, sizeof(int64_t), int64_order)
     return kept
 
 
