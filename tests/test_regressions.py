@@ -1040,3 +1040,15 @@ def test_oracle_leaves_out_a_hole_seed_that_rounds_onto_the_domain(checked):
         assert fd._strictly_outside([poly], p)
     case = fd.FuzzCase("extreme+offset", poly, 6.358823779174462e-07, {"close_factor": 0.0}, [poly])
     fd.verify(case.call(), case, check=checked)
+
+
+@pytest.mark.parametrize("close_factor", [0.84, 1.0, 1.9])
+def test_large_close_factor_still_meshes_at_the_size(checked, close_factor):
+    """From close_factor ~0.83 (1 / LATTICE_PROXIMITY) up, the proximity reach took in
+    a lattice's own neighbours: R was refused nearly everywhere and the front closed
+    on existing vertices, so the unit square at size 0.02 got 840 triangles (RR 0.84)
+    instead of about 5,700.  The reach now stays below R's side."""
+    default = aftmesh.generate(SQ, 0.02)
+    mesh = checked(aftmesh.generate(SQ, 0.02, close_factor=close_factor), domain_area=1.0)
+    assert len(mesh.triangles) > 0.9 * len(default.triangles)
+    assert mesh.quality()["radius_ratio_mean"] > 0.99

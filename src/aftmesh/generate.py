@@ -176,7 +176,9 @@ def generate(
         at most 1.5 times the side of R's triangle where the size is well above the
         front edge (short input edges), and 1.2 times that where the size is uniform
         and the apex of R's edge is not an input vertex (it keeps the seams where two
-        fronts' lattices meet one triangle wide).
+        fronts' lattices meet one triangle wide).  The reach ``close_factor * h``
+        stays below 0.95 times R's side, the distance of R's lattice neighbours, so
+        values above about 0.8 all act alike (the default reaches 0.9 of it at most).
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
