@@ -177,8 +177,10 @@ def generate(
         front edge (short input edges), and 1.2 times that where the size is uniform
         and the apex of R's edge is not an input vertex (it keeps the seams where two
         fronts' lattices meet one triangle wide).  The reach ``close_factor * h``
-        stays below 0.95 times R's side, the distance of R's lattice neighbours, so
-        values above about 0.8 all act alike (the default reaches 0.9 of it at most).
+        stays below 0.95 times R's side, the distance of R's lattice neighbours (the
+        default reaches 0.9 of it at most): a larger close_factor cannot make the
+        front refuse a uniform lattice's own points, and values from about 1 up act
+        alike.
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
