@@ -241,6 +241,14 @@ def thin_layer() -> Built:
     return Built(geom, 0.012, "annular shell 0.02 thick, h = 0.012")
 
 
+def round_plate() -> Built:
+    """A disc of radius 1 as a 256-gon, meshed at its edges' own length: the fronts
+    from the whole circle contract, so every ring of the mesh must lose points."""
+    sides = 256
+    geom = Point(0, 0).buffer(1.0, sides // 4)
+    return Built(geom, 2.0 * math.sin(math.pi / sides), "disc as a 256-gon, h = its edge")
+
+
 GP_H0, GP_SLOPE, GP_HMAX = 0.002, 0.15, 0.04  # graded from a point
 
 
@@ -295,6 +303,7 @@ BUILT = {
     "city": city,
     "mixed-holes": mixed_holes,
     "thin-layer": thin_layer,
+    "round-plate": round_plate,
     "graded-point": graded_point,
     "graded-curve": graded_curve,
 }
