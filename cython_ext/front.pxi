@@ -308,7 +308,8 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
 
     h_out is the length New_is_preferred's proximity rules measure against: the local
     size, but at most PROXIMITY_PER_SIDE * d, and LATTICE_PROXIMITY times that where
-    the size is uniform (see there), and never so long that close_factor times it
+    the size is uniform, up to CONVERGING_PROXIMITY times the size where fronts
+    converge (see there for both), and never so long that close_factor times it
     reaches PROXIMITY_REACH_MAX * d."""
     cdef double* pa = P(T, T.tv[e])
     cdef double* pb = P(T, T.tv[nxt(e)])
@@ -316,7 +317,7 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     cdef double ex = pb[0] - pa[0], ey = pb[1] - pa[1]
     cdef double L = sqrt(ex * ex + ey * ey)
     cdef double h = size_at_from(&A.size, mx, my, T.tv[e], T.tv[nxt(e)])
-    cdef double d, height, nx, ny, h_r
+    cdef double d, height, nx, ny, h_r, hb
     cdef bint uniform
     nx = -ey / L
     ny = ex / L
@@ -334,6 +335,12 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     h_out[0] = h if h < PROXIMITY_PER_SIDE * d else PROXIMITY_PER_SIDE * d
     if uniform:
         h_out[0] *= LATTICE_PROXIMITY
+        if A.size.nt == 0 and L < CONVERGING_EDGE * h and A.close_factor > 0.0:
+            hb = CONVERGING_PROXIMITY * h
+            if A.close_factor * hb > L:
+                hb = L / A.close_factor
+            if hb > h_out[0]:
+                h_out[0] = hb
     if A.close_factor * h_out[0] > PROXIMITY_REACH_MAX * d:
         h_out[0] = PROXIMITY_REACH_MAX * d / A.close_factor
 
@@ -380,6 +387,19 @@ cdef double PROXIMITY_PER_SIDE = 1.5
 # triangles in size transitions.
 cdef double LATTICE_PROXIMITY = 1.2
 cdef double UNIFORM_SIZE_TOLERANCE = 0.005
+# Where the size is one constant over the whole domain (no background field), a front
+# edge shorter than CONVERGING_EDGE times the size can only come from fronts that
+# converge: a ring closing on itself, as in a disc, or fronts meeting.  There the
+# proximity rules reach CONVERGING_PROXIMITY times the size (0.8 of it at the default
+# close_factor), but never farther than E's own length: R's neighbours in the row,
+# closer than E, are taken instead of starting another compressed row.  A disc as a
+# 256-gon meshed at its edges' length went from mean radius ratio 0.981 to 0.989
+# (Gmsh 0.997), its inner half from 0.987 to 0.999.  Not with a graded field: there
+# a short edge may be a row still growing away from short input edges, which widens
+# by itself as it moves out, and merging its points made worse triangles (rw-gear
+# 0.9825 -> 0.9803; unrestricted, 0.9793).
+cdef double CONVERGING_EDGE = 0.8
+cdef double CONVERGING_PROXIMITY = 1.6
 # The proximity rules' reach, close_factor times the length above, stays below this
 # multiple of R's side d: a lattice's own neighbours are about d from R, and a reach
 # that took them in refused R nearly everywhere, so the front closed on existing

@@ -29,7 +29,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
-from shapely.geometry import Polygon
+from shapely.geometry import Point, Polygon
 
 import aftmesh
 from aftmesh.aft import Strategy
@@ -928,3 +928,17 @@ def test_regression_slanted_edges_inverted_triangles():
     mesh = aftmesh.generate(ring, graded)
     assert (dc.orient_signs(np.asarray(mesh.points), np.asarray(mesh.triangles)) > 0).all()
     assert_valid(mesh, dc.shapely_case("diamond", Polygon(ring), 0.15))
+
+
+def test_converging_fronts_in_a_disc_merge_their_rows(checked):
+    """A disc as a 256-gon meshed at its edges' length: the fronts from the circle
+    converge, and each ring of the mesh must lose points.  The rows used to keep all
+    256 points until they were compressed to 0.6 of the size (mean radius ratio 0.981,
+    8 % more triangles than the disc's area asks for); now they merge points as soon
+    as their edges are shorter than 0.8 of the size (front.pxi, CONVERGING_EDGE)."""
+    disc = Point(0, 0).buffer(1.0, 64)
+    h = 2.0 * np.sin(np.pi / 256)
+    mesh = checked(aftmesh.generate(disc, h), domain_area=disc.area)
+    ideal = disc.area / (np.sqrt(3.0) / 4.0 * h * h)
+    assert abs(len(mesh.triangles) / ideal - 1.0) < 0.05
+    assert mesh.quality()["radius_ratio_mean"] > 0.985
