@@ -394,10 +394,10 @@ cdef double UNIFORM_SIZE_TOLERANCE = 0.005
 # close_factor), but never farther than E's own length: R's neighbours in the row,
 # closer than E, are taken instead of starting another compressed row.  A disc as a
 # 256-gon meshed at its edges' length went from mean radius ratio 0.981 to 0.989
-# (Gmsh 0.997), its inner half from 0.987 to 0.999.  Not with a graded field: there
-# a short edge may be a row still growing away from short input edges, which widens
-# by itself as it moves out, and merging its points made worse triangles (rw-gear
-# 0.9825 -> 0.9803; unrestricted, 0.9793).
+# (Gmsh 0.997), inside radius 0.6 from about 0.986 to 0.999.  Not with a graded
+# field: there a short edge may be a row still growing away from short input edges,
+# which widens by itself as it moves out, and merging its points made worse
+# triangles (rw-gear 0.9825 -> 0.9803, and 0.9793 without the cap at E's length).
 cdef double CONVERGING_EDGE = 0.8
 cdef double CONVERGING_PROXIMITY = 1.6
 # The proximity rules' reach, close_factor times the length above, stays below this
