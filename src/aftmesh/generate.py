@@ -177,13 +177,13 @@ def generate(
         front edge (short input edges), and 1.2 times that where the size is uniform
         and the apex of R's edge is not an input vertex (it keeps the seams where two
         fronts' lattices meet one triangle wide).  Where the size is one constant and
-        R's edge is shorter than 0.8 of it (fronts converging, as in a disc), ``h`` is
-        1.6 times the size, but ``close_factor * h`` at most the edge's length, so the
-        rows merge their points instead of compressing.  The reach ``close_factor * h``
-        stays below 0.95 times R's side, the distance of R's lattice neighbours (the
-        default reaches 0.9 of it at most): a larger close_factor cannot make the
-        front refuse a uniform lattice's own points, and values from about 1 up act
-        alike.
+        R's edge is shorter than 0.8 of it (fronts converging, as in a disc), ``h``
+        rises to 1.6 times the size, but no further than makes ``close_factor * h``
+        the edge's length, so the rows merge their points instead of compressing.
+        The reach ``close_factor * h`` stays below 0.95 times R's side, the distance
+        of R's lattice neighbours (the default reaches 0.9 of it at most): a larger
+        close_factor cannot make the front refuse a uniform lattice's own points, and
+        values from about 1 up act alike.
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
