@@ -40,7 +40,8 @@ class Strategy:
 
     def compute_new_candidate(self, kernel: Triangulation, E: int) -> tuple[float, float, float]:
         """A point R on the left of E, and the length h the proximity rules measure
-        against (the local size, at most 1.5 times the side of T(E, R)): (x, y, h)."""
+        against (the local size, adjusted as generate's ``close_factor`` describes):
+        (x, y, h)."""
         return kernel.compute_new_candidate(E)
 
     def new_is_preferred(
