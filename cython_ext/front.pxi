@@ -14,7 +14,8 @@
 # The queue only orders the work (Get_next_edge); it is not the definition of C, so
 # stale entries are simply skipped (lazy deletion).
 #
-# Uses: halfedge.pxd; aft.pxd (Aft, QueueItem); sizing.pxi (size_at); predicates.pxi;
+# Uses: halfedge.pxd; aft.pxd (Aft, QueueItem); sizing.pxi (size_at); lattice.pxi;
+# predicates.pxi;
 # triangulation.pxi (find_edge, insert_vertex_at, add_vertex, legalize_meshed,
 # reserve_stack, _grow); cdt.pxi (insert_segment).
 from halfedge cimport *
@@ -85,6 +86,7 @@ cdef void aft_free(Aft* A) noexcept nogil:
     free(A.left)
     free(A.right)
     free(A.scaffold_alive)
+    free(A.vkappa)
     size_field_free(&A.size)
     memset(A, 0, sizeof(Aft))
 
@@ -254,7 +256,8 @@ cdef inline double _tri_area(Tri* T, int t) noexcept nogil:
 
 cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
     """C = every constrained half-edge of an unmeshed triangle (the domain's CDT has
-    been built and carved).  Also counts the triangles for formula (4)."""
+    been built and carved).  Also counts the triangles for formula (4), and starts
+    the converging rows' lattice (lattice.pxi)."""
     cdef int t, k
     queue_clear(A)
     A.nv_input = T.nv
@@ -272,7 +275,7 @@ cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
                 if blocking(T, 3 * t + k):
                     if queue_push(A, T, 3 * t + k):
                         return ERR_NOMEM
-    return 0
+    return lattice_start(A, T)
 
 
 cdef int get_next_edge(Aft* A, Tri* T) noexcept nogil:
@@ -332,6 +335,8 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     height = sqrt(d * d - 0.25 * L * L)
     R[0] = mx + nx * height
     R[1] = my + ny * height
+    if A.lat_on:
+        lattice_snap(A, T, e, R, L, h)
     h_out[0] = h if h < PROXIMITY_PER_SIDE * d else PROXIMITY_PER_SIDE * d
     if uniform:
         h_out[0] *= LATTICE_PROXIMITY
@@ -702,6 +707,9 @@ cdef int update_internal(Aft* A, Tri* T, int e, const double* R) noexcept nogil:
         return res
     A.n_unmeshed += 2
     A.n_new += 1
+    res = lattice_new_vertex(A, T, v, a, b)
+    if res < 0:
+        return res
     f = find_edge(T, a, b)
     if f < 0:
         return ERR_INTERNAL

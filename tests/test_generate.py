@@ -935,10 +935,34 @@ def test_converging_fronts_in_a_disc_merge_their_rows(checked):
     converge, and each ring of the mesh must lose points.  The rows used to keep all
     256 points until they were compressed to 0.6 of the size (mean radius ratio 0.981,
     8 % more triangles than the disc's area asks for); now they merge points as soon
-    as their edges are shorter than 0.8 of the size (front.pxi, CONVERGING_EDGE)."""
+    as their edges are shorter than 0.8 of the size (front.pxi, CONVERGING_EDGE), or
+    give way to one lattice before that (lattice.pxi)."""
     disc = Point(0, 0).buffer(1.0, 64)
     h = 2.0 * np.sin(np.pi / 256)
     mesh = checked(aftmesh.generate(disc, h), domain_area=disc.area)
     ideal = disc.area / (np.sqrt(3.0) / 4.0 * h * h)
     assert abs(len(mesh.triangles) / ideal - 1.0) < 0.05
     assert mesh.quality()["radius_ratio_mean"] > 0.985
+
+
+@pytest.mark.parametrize(
+    ("name", "domain", "h", "floor"),
+    [
+        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 0.995),
+        (
+            "annulus",
+            Point(0, 0).buffer(1.0, 64).difference(Point(0, 0).buffer(0.5, 32)),
+            0.0245,
+            0.991,
+        ),
+    ],
+)
+def test_converging_rows_give_way_to_one_lattice(checked, name, domain, h, floor):
+    """Under one constant size, the rows from a circle that curves round the unmeshed
+    region shorten layer by layer.  Kept, each stretch of the rim grew its own lattice
+    and the seams between them held the poor triangles (mean radius ratio 0.9891 on
+    the disc, 0.9842 on the annulus); snapped to one lattice once their edges are
+    shorter than 0.97 of the size (lattice.pxi), the inside is one lattice (0.9973
+    and 0.9930)."""
+    mesh = checked(aftmesh.generate(domain, h), domain_area=domain.area)
+    assert mesh.quality()["radius_ratio_mean"] > floor, name

@@ -1,0 +1,190 @@
+# Converging rows under a constant size give way to one lattice (front.pxi calls in
+# here: Compute_new_candidate, Update_internal and the start of the compiled loop).
+#
+# Under one constant size, the rows of triangles that follow a boundary curving round
+# the unmeshed region (a disc, the outer circle of an annulus, the ends of a slot)
+# shorten layer by layer: a ring of n points at radius r still has n points at r - H.
+# Left alone they compress until the converging reach (front.pxi) merges them, and each
+# stretch of the rim grows a lattice of its own orientation, so the inside of a disc is
+# a patchwork whose seams hold its poor triangles.  Instead, once such a row's edges
+# are shorter than LATTICE_SNAP_EDGE times the size, R moves to the nearest point of
+# one equilateral lattice of the size (through input vertex 0, its rows along x) when
+# that point is within LATTICE_SNAP times the size of R: the rows give way to the
+# lattice within a few layers of the rim, and the inside is one lattice, as in Gmsh's
+# frontal-Delaunay meshes of a disc.  R stays a candidate like any other: Lemma 3.1's
+# test, Check_visible and the proximity rules judge it as before (one at a lattice
+# point an earlier R took is refused as too near, and S is taken).
+#
+# Only rows that come from a curved boundary snap.  Each vertex carries the front's
+# curvature: an input vertex the boundary's turn there per unit of length (none at a
+# corner, where the rows of the two sides meet in a seam rather than bend), a new
+# vertex that of the curve parallel to its edge through it.  Straight boundaries grow
+# lattices aligned with themselves, which a common lattice would only disturb: without
+# the condition, poly-A, poly-face and poly-double_hex3 lost 0.001-0.007 of mean radius
+# ratio, and with it their meshes are unchanged.
+#
+# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o); front.pxi (the size
+# field's constant flag, via A.size).
+from halfedge cimport *
+from aft cimport Aft
+from libc.math cimport sqrt, floor, INFINITY
+from libc.stdlib cimport malloc, free, realloc
+from libc.stdint cimport int32_t
+
+# Rows whose edges are shorter than this many sizes are converging (a straight
+# boundary's rows keep its own spacing, at most a rounding of its length below 1).
+# 0.95 let the rows compress longer: a 256-gon disc 0.9942 against 0.9955 (mean radius
+# ratio, at a reach of 0.45), the annulus of the tests 0.9929 against 0.9933.
+cdef double LATTICE_SNAP_EDGE = 0.97
+# R snaps to a lattice point this many sizes away at most (every point of the plane is
+# within 0.577 of one).  Mean radius ratio of the 256-gon disc at 0.35 / 0.4 / 0.45 /
+# 0.5: 0.9926 / 0.9927 / 0.9955 / 0.9973 (Gmsh 0.9972, 0.9891 without the lattice).
+# A slot with round ends (0.9924 without) went 0.9929 / 0.9949 / 0.9953 / 0.9954, its
+# triangles at or below radius ratio 0.9 from 41 to 59 / 62 / 76 / 93, all above the
+# 28 degrees of the minimum-angle pass.
+cdef double LATTICE_SNAP = 0.5
+# A front turning by more than this (cosine below, about 20 degrees) at a boundary
+# vertex is at a corner: no curvature there.
+cdef double LATTICE_TURN_COS_MIN = 0.94
+# Curvature times the size above this marks a curved row (a radius below 500 sizes):
+# a rounding's turn on a straight boundary stays far below.
+cdef double LATTICE_CURVED_MIN = 0.002
+# A row's curvature grows as 1 / (1 - H kappa) from layer to layer (H the layer's
+# height); near its centre of curvature the factor is held at this at most.
+cdef double LATTICE_KAPPA_GROWTH_MAX = 2.0
+# the height of an equilateral triangle of side 1
+cdef double LATTICE_ROW = 0.8660254037844386
+cdef enum:
+    # lattice_start's mark of a vertex with two front edges into it (or out of it)
+    LATTICE_AMBIGUOUS = -2
+
+
+cdef int _kappa_reserve(Aft* A, int n) noexcept nogil:
+    """A.vkappa holds at least n vertices (new entries 0); 0 or ERR_NOMEM."""
+    cdef int cap, i
+    cdef double* grown
+    if n <= A.vkappa_cap:
+        return 0
+    cap = 2 * n + 64
+    grown = <double*> realloc(A.vkappa, cap * sizeof(double))
+    if grown == NULL:
+        return ERR_NOMEM
+    for i in range(A.vkappa_cap, cap):
+        grown[i] = 0.0
+    A.vkappa = grown
+    A.vkappa_cap = cap
+    return 0
+
+
+cdef inline double _kappa(const Aft* A, int v) noexcept nogil:
+    return A.vkappa[v] if 0 <= v < A.vkappa_cap else 0.0
+
+
+cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
+    """With the frontal edge set just made: whether rows may snap (one constant size,
+    New_is_preferred in use), the lattice's origin, and each front vertex's curvature,
+    from the front edges into and out of it (none where a vertex has two of either:
+    rings touching there)."""
+    cdef int t, k, e, v, res = 0
+    cdef int32_t* into
+    cdef int32_t* out
+    A.lat_on = A.size.nt == 0 and A.close_factor > 0.0 and not A.greedy and T.nv > 0
+    if not A.lat_on:
+        return 0
+    A.lat_o[0] = T.xy[0]
+    A.lat_o[1] = T.xy[1]
+    if _kappa_reserve(A, T.nv):
+        return ERR_NOMEM
+    into = <int32_t*> malloc(2 * T.nv * sizeof(int32_t))
+    if into == NULL:
+        return ERR_NOMEM
+    out = into + T.nv
+    for v in range(2 * T.nv):
+        into[v] = NONE
+    for t in range(T.nt):
+        if T.tstate[t] != T_UNMESHED:
+            continue
+        for k in range(3):
+            e = 3 * t + k
+            if blocking(T, e):
+                v = T.tv[nxt(e)]
+                into[v] = e if into[v] == NONE else LATTICE_AMBIGUOUS
+                v = T.tv[e]
+                out[v] = e if out[v] == NONE else LATTICE_AMBIGUOUS
+    for v in range(T.nv):
+        if into[v] >= 0 and out[v] >= 0:
+            A.vkappa[v] = _turn_per_length(T, into[v], out[v])
+    free(into)
+    return res
+
+
+cdef double _turn_per_length(Tri* T, int e, int f) noexcept nogil:
+    """The front's curvature where edge e ends and edge f starts: the turn's sine over
+    the mean of the two lengths, or 0 at a corner."""
+    cdef const double* pa = P(T, T.tv[e])
+    cdef const double* pb = P(T, T.tv[f])
+    cdef const double* pc = P(T, T.tv[nxt(f)])
+    cdef double ux = pb[0] - pa[0], uy = pb[1] - pa[1]
+    cdef double vx = pc[0] - pb[0], vy = pc[1] - pb[1]
+    cdef double lu = sqrt(ux * ux + uy * uy), lv = sqrt(vx * vx + vy * vy)
+    if not (lu > 0.0 and lv > 0.0) or ux * vx + uy * vy < LATTICE_TURN_COS_MIN * lu * lv:
+        return 0.0
+    return 2.0 * (ux * vy - uy * vx) / (lu * lv * (lu + lv))
+
+
+cdef int lattice_new_vertex(Aft* A, Tri* T, int v, int a, int b) noexcept nogil:
+    """New vertex v, made on front edge a -> b: its curvature (see the top)."""
+    cdef double kappa, height, L, shrink
+    cdef const double* pa
+    cdef const double* pb
+    cdef const double* pv
+    if not A.lat_on:
+        return 0
+    if _kappa_reserve(A, v + 1):
+        return ERR_NOMEM
+    kappa = 0.5 * (_kappa(A, a) + _kappa(A, b))
+    A.vkappa[v] = 0.0
+    if kappa == 0.0:
+        return 0
+    pa = P(T, a)
+    pb = P(T, b)
+    pv = P(T, v)
+    L = sqrt((pb[0] - pa[0]) * (pb[0] - pa[0]) + (pb[1] - pa[1]) * (pb[1] - pa[1]))
+    if not L > 0.0:
+        return 0
+    height = ((pb[0] - pa[0]) * (pv[1] - pa[1]) - (pb[1] - pa[1]) * (pv[0] - pa[0])) / L
+    shrink = 1.0 - height * kappa
+    if not shrink >= 1.0 / LATTICE_KAPPA_GROWTH_MAX:
+        shrink = 1.0 / LATTICE_KAPPA_GROWTH_MAX
+    A.vkappa[v] = kappa / shrink
+    return 0
+
+
+cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double L, double h) noexcept nogil:
+    """Move R to the nearest lattice point when front edge e (of length L, under the
+    constant size h) is in a converging curved row and that point is near enough."""
+    cdef double kappa, x, y, i, j, px, py, d2, best = INFINITY, bx = 0.0, by = 0.0
+    cdef double row = LATTICE_ROW * h
+    cdef int di, dj
+    if not L < LATTICE_SNAP_EDGE * h:
+        return
+    kappa = 0.5 * (_kappa(A, T.tv[e]) + _kappa(A, T.tv[nxt(e)]))
+    if not kappa * h > LATTICE_CURVED_MIN:
+        return
+    x = R[0] - A.lat_o[0]
+    y = R[1] - A.lat_o[1]
+    j = floor(y / row + 0.5)
+    i = floor(x / h - 0.5 * j + 0.5)
+    # the rounding above can miss the nearest point by one: try the neighbours too
+    for dj in range(-1, 2):
+        for di in range(-1, 2):
+            px = (i + di + 0.5 * (j + dj)) * h
+            py = (j + dj) * row
+            d2 = (px - x) * (px - x) + (py - y) * (py - y)
+            if d2 < best:
+                best = d2
+                bx = px
+                by = py
+    if best < (LATTICE_SNAP * h) * (LATTICE_SNAP * h):
+        R[0] = A.lat_o[0] + bx
+        R[1] = A.lat_o[1] + by
