@@ -29,6 +29,7 @@ from halfedge cimport *
 from aft cimport Aft
 from libc.math cimport sqrt, floor, INFINITY
 from libc.stdlib cimport malloc, free, realloc
+from libc.string cimport memset
 from libc.stdint cimport int32_t
 
 # Rows whose edges are shorter than this many sizes are converging (a straight
@@ -95,6 +96,7 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
     A.lat_o[1] = T.xy[1]
     if _kappa_reserve(A, T.nv):
         return ERR_NOMEM
+    memset(A.vkappa, 0, A.vkappa_cap * sizeof(double))     # nothing from an earlier run
     into = <int32_t*> malloc(2 * T.nv * sizeof(int32_t))
     if into == NULL:
         return ERR_NOMEM
