@@ -83,10 +83,11 @@ cdef inline double _kappa(const Aft* A, int v) noexcept nogil:
 
 cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
     """With the frontal edge set just made: whether rows may snap (one constant size,
-    New_is_preferred in use), the lattice's origin, and each front vertex's curvature,
-    from the front edges into and out of it (none where a vertex has two of either:
-    rings touching there)."""
+    New_is_preferred in use, a curved stretch of boundary), the lattice's origin, and
+    each front vertex's curvature, from the front edges into and out of it (none where
+    a vertex has two of either: rings touching there)."""
     cdef int t, k, e, v, res = 0
+    cdef bint curved
     cdef int32_t* into
     cdef int32_t* out
     A.lat_on = A.size.nt == 0 and A.close_factor > 0.0 and not A.greedy and T.nv > 0
@@ -113,10 +114,16 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
                 into[v] = e if into[v] == NONE else LATTICE_AMBIGUOUS
                 v = T.tv[e]
                 out[v] = e if out[v] == NONE else LATTICE_AMBIGUOUS
+    curved = False
     for v in range(T.nv):
         if into[v] >= 0 and out[v] >= 0:
             A.vkappa[v] = _turn_per_length(T, into[v], out[v])
+            curved = curved or A.vkappa[v] * A.size.constant > LATTICE_CURVED_MIN
     free(into)
+    # without a curved stretch of boundary no row ever snaps: then the loop skips
+    # the lattice's bookkeeping altogether (the unit square at size 0.01 ran 0.8 % more
+    # instructions than before the lattice without this, 0.3 % with it)
+    A.lat_on = curved
     return res
 
 
