@@ -34,16 +34,18 @@ from libc.stdint cimport int32_t
 
 # Rows whose edges are shorter than this many sizes are converging (a straight
 # boundary's rows keep its own spacing, at most a rounding of its length below 1).
-# 0.95 let the rows compress longer: a 256-gon disc 0.9942 against 0.9955 (mean radius
-# ratio, at a reach of 0.45), the annulus of the tests 0.9929 against 0.9933.
+# 0.95 let the rows compress longer: over the five turns below, the disc 0.9918-0.9931
+# and the annulus 0.9880-0.9910 against 0.9921-0.9935 and 0.9888-0.9925 at 0.97.
 cdef double LATTICE_SNAP_EDGE = 0.97
 # R snaps to a lattice point this many sizes away at most (every point of the plane is
-# within 0.577 of one).  Mean radius ratio of the 256-gon disc at 0.35 / 0.4 / 0.45 /
-# 0.5: 0.9926 / 0.9927 / 0.9955 / 0.9973 (Gmsh 0.9972, 0.9891 without the lattice).
-# A slot with round ends (0.9924 without) went 0.9929 / 0.9949 / 0.9953 / 0.9954, its
-# triangles at or below radius ratio 0.9 from 41 to 59 / 62 / 76 / 93, all above the
-# 28 degrees of the minimum-angle pass.
-cdef double LATTICE_SNAP = 0.5
+# within 0.577 of one).  The 256-gon disc, an annulus and a slot with round ends, each
+# turned by 3, 11, 29, 47 and 71 degrees (which moves the lattice's phase against the
+# rim): at 0.4 every one rose above its mean radius ratio without the lattice (disc
+# 0.9921-0.9935 against 0.9871-0.9895, annulus 0.9888-0.9925 against 0.9843-0.9846,
+# slot 0.9934-0.9941 against 0.9920-0.9925) with at most 79 triangles at or below 0.9;
+# at 0.45 and 0.5 the disc reached 0.9973 at some angles but fell to 0.9896 and 0.9868,
+# with 238 and 404 such triangles, at others.
+cdef double LATTICE_SNAP = 0.4
 # A front turning by more than this (cosine below, about 20 degrees) at a boundary
 # vertex is at a corner: no curvature there.
 cdef double LATTICE_TURN_COS_MIN = 0.94
