@@ -45,9 +45,6 @@ VARIANTS = (
 # Left out by default: about 0.76 M triangles, several seconds a call, and the README's
 # real-world averages leave it out too (a mesher fails on it).
 SLOW_CASES = ("rw-poly2tri-debug2",)
-# A triangle at or below this radius ratio counts as poor (the real-world table's
-# threshold).
-POOR = 0.9
 README = Path(__file__).resolve().parent.parent / "README.md"
 MARKS = ("<!-- options:start -->", "<!-- options:end -->")
 
@@ -66,7 +63,8 @@ def parse_variant(text: str) -> dict:
 def measure(name: str, options: dict, repeat: int) -> dict:
     """One case at one set of options: quality of the mesh and median CPU time."""
     import aftmesh
-    from aftmesh.mesh import triangle_quality
+
+    from .measure import quality_stats
 
     case = build_case(name)
     domain = case.as_triangle_dict()
@@ -76,14 +74,14 @@ def measure(name: str, options: dict, repeat: int) -> dict:
         t = time.process_time()
         mesh = aftmesh.generate(domain, case.size_arg, **options)
         times.append(time.process_time() - t)
-    q = triangle_quality(mesh.points, mesh.triangles)
-    rr = q["radius_ratio"]
+    q = quality_stats(mesh.points, mesh.triangles)
+    n = q["triangles"]
     return {
-        "triangles": len(mesh.triangles),
-        "rr_mean": float(rr.mean()),
-        "share": float((rr > POOR).mean()),
-        "poor": int((rr <= POOR).sum()),
-        "min_angle": float(q["min_angle"].min()),
+        "triangles": n,
+        "rr_mean": q["rr_mean"],
+        "share": q["rr_above_0.9"],
+        "poor": n - round(q["rr_above_0.9"] * n),
+        "min_angle": q["min_angle"],
         "cpu": statistics.median(times),
     }
 

@@ -1,5 +1,5 @@
 # Converging rows under a constant size give way to one lattice (front.pxi calls in
-# here: Compute_new_candidate, Update_internal and the start of the compiled loop).
+# here: Convert_to_frontal_edge_set, Compute_new_candidate and Update_internal).
 #
 # Under one constant size, the rows of triangles that follow a boundary curving round
 # the unmeshed region (a disc, the outer circle of an annulus, the ends of a slot)
@@ -23,12 +23,12 @@
 # the condition, poly-A, poly-face and poly-double_hex3 lost 0.001-0.007 of mean radius
 # ratio, and with it their meshes are unchanged.
 #
-# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o); front.pxi (the size
-# field's constant flag, via A.size).
+# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o, and the size field's
+# constant); triangulation.pxi (_grow).
 from halfedge cimport *
 from aft cimport Aft
 from libc.math cimport sqrt, floor, INFINITY
-from libc.stdlib cimport malloc, free, realloc
+from libc.stdlib cimport malloc, free
 from libc.string cimport memset
 from libc.stdint cimport int32_t
 
@@ -65,16 +65,13 @@ cdef enum:
 cdef int _kappa_reserve(Aft* A, int n) noexcept nogil:
     """A.vkappa holds at least n vertices (new entries 0); 0 or ERR_NOMEM."""
     cdef int cap, i
-    cdef double* grown
     if n <= A.vkappa_cap:
         return 0
     cap = 2 * n + 64
-    grown = <double*> realloc(A.vkappa, cap * sizeof(double))
-    if grown == NULL:
+    if _grow(<void**> &A.vkappa, cap * sizeof(double)):
         return ERR_NOMEM
     for i in range(A.vkappa_cap, cap):
-        grown[i] = 0.0
-    A.vkappa = grown
+        A.vkappa[i] = 0.0
     A.vkappa_cap = cap
     return 0
 
