@@ -309,8 +309,8 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     faster than the front; where the size grows away from E (it is larger at the
     first guess of R than at E's midpoint), by at most R_SIDE_MAX_GROWING |E|.
 
-    Under one constant size, R of an edge in a row converging from a curved boundary
-    may move to the nearest point of one lattice (lattice.pxi).
+    Under one constant size, R of an edge in a row from a curved boundary may move
+    to the nearest point of one lattice (lattice.pxi).
 
     h_out is the length New_is_preferred's proximity rules measure against: the local
     size, but at most PROXIMITY_PER_SIDE * d, and LATTICE_PROXIMITY times that where
@@ -339,7 +339,7 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     R[0] = mx + nx * height
     R[1] = my + ny * height
     if A.lat_on:
-        lattice_snap(A, T, e, R, L, h)
+        lattice_snap(A, T, e, R, h)
     h_out[0] = h if h < PROXIMITY_PER_SIDE * d else PROXIMITY_PER_SIDE * d
     if uniform:
         h_out[0] *= LATTICE_PROXIMITY

@@ -6,14 +6,23 @@
 # shorten layer by layer: a ring of n points at radius r still has n points at r - H.
 # Left alone they compress until the converging reach (front.pxi) merges them, and each
 # stretch of the rim grows a lattice of its own orientation, so the inside of a disc is
-# a patchwork whose seams hold its poor triangles.  Instead, once such a row's edges
-# are shorter than LATTICE_SNAP_EDGE times the size, R moves to the nearest point of
-# one equilateral lattice of the size (through input vertex 0, its rows along x) when
-# that point is within LATTICE_SNAP times the size of R: the rows give way to the
-# lattice within a few layers of the rim, and the inside is one lattice, as in Gmsh's
-# frontal-Delaunay meshes of a disc.  R stays a candidate like any other: Lemma 3.1's
-# test, Check_visible and the proximity rules judge it as before (one at a lattice
-# point an earlier R took is refused as too near, and S is taken).
+# a patchwork whose seams hold its poor triangles.  Instead, R of an edge in such a row
+# moves to the nearest point of one equilateral lattice of the size (its rows along x)
+# when that point is within LATTICE_SNAP times the size of R: the rows give way to the
+# lattice from the rim on, and the inside is one lattice, as in Gmsh's frontal-Delaunay
+# meshes of a disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible
+# and the proximity rules judge it as before (one at a lattice point an earlier R took
+# is refused as too near, and S is taken).
+#
+# Why from the first row, and why the centroid: the lattice has a point at the
+# centroid of the region the front encloses, so that it sits on a disc's or an
+# annulus's centre whatever the rim's own vertices are, and the seam between the rows
+# and the lattice then stays next to the rim.  Over the 256-gon disc, an annulus and
+# a slot, each turned by 0, 3, 11, 29, 47 and 71 degrees, a lattice through input
+# vertex 0 that rows joined once their edges were below 0.97 of the size averaged
+# 0.9927 / 0.9909 / 0.9939 in mean radius ratio; joining from the first row, 0.9949 /
+# 0.9921 / 0.9946; with the centroid too, 0.9964 / 0.9932 / 0.9940 (Gmsh's disc:
+# 0.9972).
 #
 # Only rows that come from a curved boundary snap.  Each vertex carries the front's
 # curvature: an input vertex the boundary's turn there per unit of length (none at a
@@ -27,24 +36,18 @@
 # constant); triangulation.pxi (_grow).
 from halfedge cimport *
 from aft cimport Aft
-from libc.math cimport sqrt, floor, INFINITY
+from libc.math cimport sqrt, floor, isfinite, INFINITY
 from libc.stdlib cimport malloc, free
 from libc.string cimport memset
 from libc.stdint cimport int32_t
 
-# Rows whose edges are shorter than this many sizes are converging (a straight
-# boundary's rows keep its own spacing, at most a rounding of its length below 1).
-# 0.95 let the rows compress longer: over the five turns below, the disc 0.9918-0.9931
-# and the annulus 0.9880-0.9910 against 0.9921-0.9935 and 0.9888-0.9925 at 0.97.
-cdef double LATTICE_SNAP_EDGE = 0.97
 # R snaps to a lattice point this many sizes away at most (every point of the plane is
-# within 0.577 of one).  The 256-gon disc, an annulus and a slot with round ends, each
-# turned by 3, 11, 29, 47 and 71 degrees (which moves the lattice's phase against the
-# rim): at 0.4 every one rose above its mean radius ratio without the lattice (disc
-# 0.9921-0.9935 against 0.9871-0.9895, annulus 0.9888-0.9925 against 0.9843-0.9846,
-# slot 0.9934-0.9941 against 0.9920-0.9925) with at most 79 triangles at or below 0.9;
-# at 0.45 and 0.5 the disc reached 0.9973 at some angles but fell to 0.9896 and 0.9868,
-# with 238 and 404 such triangles, at others.
+# within 0.577 of one).  Over the 256-gon disc, the annulus and the slot at the six
+# turns above (the turn moves the lattice against the rim), the mean radius ratio
+# averaged 0.9890 / 0.9872 / 0.9918 at 0.3, 0.9950 / 0.9915 / 0.9938 at 0.35,
+# 0.9964 / 0.9932 / 0.9940 at 0.4, 0.9963 / 0.9920 / 0.9948 at 0.45 and 0.9956 /
+# 0.9912 / 0.9940 at 0.5, and above 0.4 the triangles at or below 0.9 grew (the
+# annulus's worst turn 113 at 0.4, 244 at 0.45, 275 at 0.5).
 cdef double LATTICE_SNAP = 0.4
 # A front turning by more than this (cosine below, about 20 degrees) at a boundary
 # vertex is at a corner: no curvature there.
@@ -92,8 +95,6 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
     A.lat_on = A.size.nt == 0 and A.close_factor > 0.0 and not A.greedy and T.nv > 0
     if not A.lat_on:
         return 0
-    A.lat_o[0] = T.xy[0]
-    A.lat_o[1] = T.xy[1]
     if _kappa_reserve(A, T.nv):
         return ERR_NOMEM
     memset(A.vkappa, 0, A.vkappa_cap * sizeof(double))     # nothing from an earlier run
@@ -113,6 +114,7 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
                 into[v] = e if into[v] == NONE else LATTICE_AMBIGUOUS
                 v = T.tv[e]
                 out[v] = e if out[v] == NONE else LATTICE_AMBIGUOUS
+    _centroid_origin(A, T, into)
     curved = False
     for v in range(T.nv):
         if into[v] >= 0 and out[v] >= 0:
@@ -124,6 +126,38 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
     # instructions than before the lattice without this, 0.3 % with it)
     A.lat_on = curved
     return 0
+
+
+cdef void _centroid_origin(Aft* A, Tri* T, const int32_t* into) noexcept nogil:
+    """A.lat_o: the centroid of the region the front edges enclose (each vertex's edge
+    into it, NONE or LATTICE_AMBIGUOUS where lattice_start found none or two: a
+    ring's vertex where rings touch then leaves out its edge, which moves the origin a
+    little and nothing else), by the shoelace sums about input vertex 0, so that
+    coordinates far from 0 do not cancel.  Input vertex 0 where the sums are not
+    usable."""
+    cdef int v, e
+    cdef double ox = T.xy[0], oy = T.xy[1], ax, ay, bx, by, c
+    cdef double a2 = 0.0, cx = 0.0, cy = 0.0
+    cdef const double* p
+    A.lat_o[0] = ox
+    A.lat_o[1] = oy
+    for v in range(T.nv):
+        e = into[v]
+        if e < 0:
+            continue
+        p = P(T, T.tv[e])
+        ax = p[0] - ox
+        ay = p[1] - oy
+        p = P(T, v)
+        bx = p[0] - ox
+        by = p[1] - oy
+        c = ax * by - bx * ay
+        a2 += c
+        cx += (ax + bx) * c
+        cy += (ay + by) * c
+    if a2 > 0.0 and isfinite(cx / a2) and isfinite(cy / a2):
+        A.lat_o[0] = ox + cx / (3.0 * a2)
+        A.lat_o[1] = oy + cy / (3.0 * a2)
 
 
 cdef double _turn_per_length(Tri* T, int e, int f) noexcept nogil:
@@ -168,14 +202,12 @@ cdef int lattice_new_vertex(Aft* A, Tri* T, int v, int a, int b) noexcept nogil:
     return 0
 
 
-cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double L, double h) noexcept nogil:
-    """Move R to the nearest lattice point when front edge e (of length L, under the
-    constant size h) is in a converging curved row and that point is near enough."""
+cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogil:
+    """Move R to the nearest lattice point when front edge e (under the constant size
+    h) is in a curved row and that point is near enough."""
     cdef double kappa, x, y, i, j, px, py, d2, best = INFINITY, bx = 0.0, by = 0.0
     cdef double row = LATTICE_ROW * h
     cdef int di, dj
-    if not L < LATTICE_SNAP_EDGE * h:
-        return
     kappa = 0.5 * (_kappa(A, T.tv[e]) + _kappa(A, T.tv[nxt(e)]))
     if not kappa * h > LATTICE_CURVED_MIN:
         return
