@@ -8,9 +8,10 @@
 # stretch of the rim grows a lattice of its own orientation, so the inside of a disc is
 # a patchwork whose seams hold its poor triangles.  Instead, R of an edge in such a row
 # moves to the nearest point of one equilateral lattice of the size (its rows along x)
-# when that point is within LATTICE_SNAP times the size of R: the rows give way to the
-# lattice from the rim on, and the inside is one lattice, as in Gmsh's frontal-Delaunay
-# meshes of a disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible
+# when that point is within LATTICE_SNAP times the size of R (LATTICE_SNAP_INNER
+# between two of Basic_aft's own vertices): the rows give way to the lattice from the
+# rim on, and the inside is one lattice, as in Gmsh's frontal-Delaunay meshes of a
+# disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible
 # and the proximity rules judge it as before (one at a lattice point an earlier R took
 # is refused as too near, and S is taken).
 #
@@ -21,8 +22,8 @@
 # a slot, each turned by 0, 3, 11, 29, 47 and 71 degrees, a lattice through input
 # vertex 0 that rows joined once their edges were below 0.97 of the size averaged
 # 0.9927 / 0.9909 / 0.9939 in mean radius ratio; joining from the first row, 0.9949 /
-# 0.9921 / 0.9946; with the centroid too, 0.9964 / 0.9932 / 0.9940 (Gmsh's disc:
-# 0.9972).
+# 0.9921 / 0.9946; with the centroid too, 0.9964 / 0.9932 / 0.9940, and with the
+# reaches below 0.9975 / 0.9940 / 0.9948 (Gmsh's disc: 0.9972).
 #
 # Only rows that come from a curved boundary snap.  Each vertex carries the front's
 # curvature: an input vertex the boundary's turn there per unit of length (none at a
@@ -42,13 +43,21 @@ from libc.string cimport memset
 from libc.stdint cimport int32_t
 
 # R snaps to a lattice point this many sizes away at most (every point of the plane is
-# within 0.577 of one).  Over the 256-gon disc, the annulus and the slot at the six
-# turns above (the turn moves the lattice against the rim), the mean radius ratio
-# averaged 0.9890 / 0.9872 / 0.9918 at 0.3, 0.9950 / 0.9915 / 0.9938 at 0.35,
-# 0.9964 / 0.9932 / 0.9940 at 0.4, 0.9963 / 0.9920 / 0.9948 at 0.45 and 0.9956 /
-# 0.9912 / 0.9940 at 0.5, and above 0.4 the triangles at or below 0.9 grew (the
-# annulus's worst turn 113 at 0.4, 244 at 0.45, 275 at 0.5).
+# within 0.577 of one): LATTICE_SNAP for an edge with an end on the boundary (the first
+# row, whose shape the rim's spacing fixes), LATTICE_SNAP_INNER for an edge between
+# two of Basic_aft's vertices.  Over the 256-gon disc, the annulus and the slot at the
+# six turns above (a turn moves the lattice against the rim), the mean radius ratio
+# averaged, with one reach for both: 0.9890 / 0.9872 / 0.9918 at 0.3, 0.9950 / 0.9915
+# / 0.9938 at 0.35, 0.9964 / 0.9932 / 0.9940 at 0.4, 0.9963 / 0.9920 / 0.9948 at 0.45
+# and 0.9956 / 0.9912 / 0.9940 at 0.5, the triangles at or below 0.9 growing above 0.4
+# (the annulus's worst turn 113 at 0.4, 275 at 0.5): a far reach at the rim forces
+# poor triangles there.  Inside, a farther reach ends the rows' seams sooner: 0.4 and
+# 0.5 gave 0.9975 / 0.9940 / 0.9948 (the disc's worst turn 36 such triangles instead
+# of 62, the slot's 91 instead of 149); 0.45 inside 0.9970 / 0.9932 / 0.9942; 0.55
+# inside the same as 0.5; 0.3 or 0.35 at the rim with 0.5 inside left the slot at
+# 0.9939 / 0.9940 with up to 182 such triangles.
 cdef double LATTICE_SNAP = 0.4
+cdef double LATTICE_SNAP_INNER = 0.5
 # A front turning by more than this (cosine below, about 20 degrees) at a boundary
 # vertex is at a corner: no curvature there.
 cdef double LATTICE_TURN_COS_MIN = 0.94
@@ -207,6 +216,7 @@ cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogi
     h) is in a curved row and that point is near enough."""
     cdef double kappa, x, y, i, j, px, py, d2, best = INFINITY, bx = 0.0, by = 0.0
     cdef double row = LATTICE_ROW * h
+    cdef double reach
     cdef int di, dj
     kappa = 0.5 * (_kappa(A, T.tv[e]) + _kappa(A, T.tv[nxt(e)]))
     if not kappa * h > LATTICE_CURVED_MIN:
@@ -225,6 +235,9 @@ cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogi
                 best = d2
                 bx = px
                 by = py
-    if best < (LATTICE_SNAP * h) * (LATTICE_SNAP * h):
+    reach = LATTICE_SNAP
+    if T.tv[e] >= A.nv_input and T.tv[nxt(e)] >= A.nv_input:
+        reach = LATTICE_SNAP_INNER
+    if best < (reach * h) * (reach * h):
         R[0] = A.lat_o[0] + bx
         R[1] = A.lat_o[1] + by

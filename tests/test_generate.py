@@ -949,15 +949,15 @@ def test_converging_fronts_in_a_disc_merge_their_rows(checked):
 @pytest.mark.parametrize(
     ("name", "domain", "h", "turn", "floor"),
     [
-        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 0.0, 0.995),
-        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 29.0, 0.995),
-        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 47.0, 0.995),
+        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 0.0, 0.997),
+        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 29.0, 0.997),
+        ("disc", Point(0, 0).buffer(1.0, 64), 2.0 * np.sin(np.pi / 256), 47.0, 0.996),
         (
             "annulus",
             Point(0, 0).buffer(1.0, 64).difference(Point(0, 0).buffer(0.5, 32)),
             0.0245,
             0.0,
-            0.991,
+            0.992,
         ),
     ],
 )
@@ -968,8 +968,9 @@ def test_converging_rows_give_way_to_one_lattice(checked, name, domain, h, turn,
     the disc, 0.9842 on the annulus).  Snapped to one lattice through input vertex 0
     once their edges were shorter than 0.97 of the size, the disc reached 0.9921-0.9935
     over turns of 0-71 degrees (the turn moves the lattice against the rim).  Snapped
-    from the first row to a lattice with a point at the centroid (lattice.pxi), the
-    seam stays next to the rim: 0.9957-0.9969, and the annulus 0.9918 unturned."""
+    from the first row to a lattice with a point at the centroid (lattice.pxi), and
+    from farther away between Basic_aft's own vertices than next to the rim, the seam
+    stays next to the rim: 0.9972-0.9977 (Gmsh: 0.9972), the annulus 0.9927 unturned."""
     domain = affinity.rotate(domain, turn, origin=(0.1, 0.2))
     mesh = checked(aftmesh.generate(domain, h), domain_area=domain.area)
     assert mesh.quality()["radius_ratio_mean"] > floor, name
