@@ -816,6 +816,21 @@ def test_random_circular_holes(poly, size):
     assert_count_formula(mesh, expected_m=[len(poly.interiors)])
 
 
+@settings(max_examples=25)
+@given(domain=dc.curved_domains())
+def test_random_curved_domains_snapping_to_the_lattice_stay_valid(domain):
+    """Under one constant size, rows from a curved boundary move R onto one lattice
+    (lattice.pxi).  R stays a candidate like any other, so the mesh is a valid CDT
+    holding the minimum-angle bound, on discs, ellipses, slots, rounded boxes and
+    holed discs at any turn and place."""
+    poly, size = domain
+    case = dc.shapely_case("curved", poly, size)
+    mesh = aftmesh.generate(poly, size)
+    assert_valid(mesh, case)
+    assert_count_formula(mesh, expected_m=[len(poly.interiors)])
+    assert mesh.info["min_angle"]["reached"], mesh.info["min_angle"]
+
+
 @given(poly=dc.polygons_with_circular_holes())
 def test_random_circular_holes_greedy(poly):
     case = dc.shapely_case("holes", poly, 0.3)
