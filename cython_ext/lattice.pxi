@@ -11,9 +11,9 @@
 # when that point is within LATTICE_SNAP times the size of R (LATTICE_SNAP_INNER
 # between two of Basic_aft's own vertices): the rows give way to the lattice from the
 # rim on, and the inside is one lattice, as in Gmsh's frontal-Delaunay meshes of a
-# disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible
-# and the proximity rules judge it as before (one at a lattice point an earlier R took
-# is refused as too near, and S is taken).
+# disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible and the
+# proximity rules judge it as before (one at a lattice point an earlier R took is
+# refused as too near, and S is taken).
 #
 # Why from the first row, and why the centroid: the lattice has a point at the
 # centroid of the region the front encloses, so that it sits on a disc's or an
