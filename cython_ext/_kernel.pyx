@@ -709,6 +709,14 @@ cdef class Triangulation:
         compute_new_candidate(&self.A, &self.T, e, R, &h)
         return R[0], R[1], h
 
+    def candidate_off_lattice(self):
+        """(x, y) of R as the last compute_new_candidate first put it, when it then
+        moved R onto the lattice of converging rows (cython_ext/lattice.pxi); None when
+        it did not."""
+        if not self.A.lat_moved:
+            return None
+        return self.A.lat_plain[0], self.A.lat_plain[1]
+
     def compute_existing_candidate(self, int e):
         self._check_front(e)
         return compute_existing_candidate(&self.T, e)

@@ -338,6 +338,7 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     height = sqrt(d * d - 0.25 * L * L)
     R[0] = mx + nx * height
     R[1] = my + ny * height
+    A.lat_moved = False
     if A.lat_on:
         lattice_snap(A, T, e, R, h)
     h_out[0] = h if h < PROXIMITY_PER_SIDE * d else PROXIMITY_PER_SIDE * d
@@ -772,6 +773,13 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
             e = _remove_in_the_way(A, T, S, a, b)
             if e < 0:
                 return e
+            continue
+        if not new and A.lat_moved:
+            # the lattice point was refused (an earlier R took it, or it is not
+            # visible): judge R where Compute_new_candidate first put it
+            A.lat_moved = False
+            R[0] = A.lat_plain[0]
+            R[1] = A.lat_plain[1]
             continue
         break
     if new:

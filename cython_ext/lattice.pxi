@@ -6,24 +6,35 @@
 # shorten layer by layer: a ring of n points at radius r still has n points at r - H.
 # Left alone they compress until the converging reach (front.pxi) merges them, and each
 # stretch of the rim grows a lattice of its own orientation, so the inside of a disc is
-# a patchwork whose seams hold its poor triangles.  Instead, R of an edge in such a row
-# moves to the nearest point of one equilateral lattice of the size (its rows along x)
-# when that point is within LATTICE_SNAP times the size of R (LATTICE_SNAP_INNER
-# between two of Basic_aft's own vertices): the rows give way to the lattice from the
-# rim on, and the inside is one lattice, as in Gmsh's frontal-Delaunay meshes of a
-# disc.  R stays a candidate like any other: Lemma 3.1's test, Check_visible and the
-# proximity rules judge it as before (one at a lattice point an earlier R took is
-# refused as too near, and S is taken).
+# a patchwork whose seams hold its poor triangles.  Instead, from the second row on
+# (an edge between two of Basic_aft's own vertices), R moves to the nearest point of
+# one equilateral lattice of the size (its rows along x, a point at the centroid of the
+# region the front encloses): the inside is one lattice, as in Gmsh's frontal-Delaunay
+# meshes of a disc, and the seam between the rows and the lattice is the first row.
+# R stays a candidate like any other: Lemma 3.1's test, Check_visible and the proximity
+# rules judge it as before, and where they refuse the lattice point (an earlier R took
+# it, or it is out of sight), basic_aft_step judges R where Compute_new_candidate first
+# put it before taking S.
 #
-# Why from the first row, and why the centroid: the lattice has a point at the
-# centroid of the region the front encloses, so that it sits on a disc's or an
-# annulus's centre whatever the rim's own vertices are, and the seam between the rows
-# and the lattice then stays next to the rim.  Over the 256-gon disc, an annulus and
-# a slot, each turned by 0, 3, 11, 29, 47 and 71 degrees, a lattice through input
-# vertex 0 that rows joined once their edges were below 0.97 of the size averaged
-# 0.9927 / 0.9909 / 0.9939 in mean radius ratio; joining from the first row, 0.9949 /
-# 0.9921 / 0.9946; with the centroid too, 0.9964 / 0.9932 / 0.9940, and with the
-# reaches below 0.9975 / 0.9940 / 0.9948 (Gmsh's disc: 0.9972).
+# Why so: over the 256-gon disc, an annulus and a slot, each turned by 0, 3, 11, 29,
+# 47 and 71 degrees, the mean radius ratio averaged 0.9927 / 0.9909 / 0.9939 with a
+# lattice through input vertex 0 that rows joined once their edges were below 0.97
+# of the size and R within 0.4 of the size of a lattice point; from the first row on,
+# 0.9949 / 0.9921 / 0.9946; with the centroid, which sits on a disc's or an annulus's
+# centre whatever the rim's own vertices are, 0.9964 / 0.9932 / 0.9940; reaching 0.5
+# between new vertices, 0.9975 / 0.9940 / 0.9948.  There a refused lattice point sent
+# the front to S, and where fronts met last such refusals closed the gap with large
+# poor triangles (the annulus's worst turn had 114 triangles at or below 0.9).
+# Judging the plain R instead made 0.9976 / 0.9952 / 0.9951, and it let the first
+# row's reach fall: 0.35, 0.3, 0.25, 0.2 and none gave 0.9976-0.9979 / 0.9953-0.9956
+# / 0.9951-0.9953, the fewest poor triangles without it (disc and annulus none, the
+# slot 4-14 against 27-53 at 0.4); and from the second row R always moves (every
+# point of the plane is within 0.577 of the size of a lattice point), which did as
+# well as a reach of 0.5 or 0.55.  On two sets of 60 and 90 random discs, ellipses,
+# slots and rounded boxes, the rule as it stands (against the 0.4 / 0.5 reaches
+# without the plain R) took the mean radius ratio from 0.9930 to 0.9932 and from
+# 0.9935 to 0.9937, and the triangles at or below 0.9 from 97 to 81 and from 89 to 69
+# a domain.
 #
 # Only rows that come from a curved boundary snap.  Each vertex carries the front's
 # curvature: an input vertex the boundary's turn there per unit of length (none at a
@@ -33,8 +44,8 @@
 # the condition, poly-A, poly-face and poly-double_hex3 lost 0.001-0.007 of mean radius
 # ratio, and with it their meshes are unchanged.
 #
-# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o, and the size field's
-# constant); triangulation.pxi (_grow).
+# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o, lat_moved, lat_plain, and
+# the size field's constant); triangulation.pxi (_grow).
 from halfedge cimport *
 from aft cimport Aft
 from libc.math cimport sqrt, floor, isfinite, INFINITY
@@ -42,22 +53,6 @@ from libc.stdlib cimport malloc, free
 from libc.string cimport memset
 from libc.stdint cimport int32_t
 
-# R snaps to a lattice point this many sizes away at most (every point of the plane is
-# within 0.577 of one): LATTICE_SNAP for an edge with an end on the boundary (the first
-# row, whose shape the rim's spacing fixes), LATTICE_SNAP_INNER for an edge between
-# two of Basic_aft's vertices.  Over the 256-gon disc, the annulus and the slot at the
-# six turns above (a turn moves the lattice against the rim), the mean radius ratio
-# averaged, with one reach for both: 0.9890 / 0.9872 / 0.9918 at 0.3, 0.9950 / 0.9915
-# / 0.9938 at 0.35, 0.9964 / 0.9932 / 0.9940 at 0.4, 0.9963 / 0.9920 / 0.9948 at 0.45
-# and 0.9956 / 0.9912 / 0.9940 at 0.5, the triangles at or below 0.9 growing above 0.4
-# (the annulus's worst turn 113 at 0.4, 275 at 0.5): a far reach at the rim forces
-# poor triangles there.  Inside, a farther reach ends the rows' seams sooner: 0.4 and
-# 0.5 gave 0.9975 / 0.9940 / 0.9948 (the disc's worst turn 36 such triangles instead
-# of 62, the slot's 91 instead of 149); 0.45 inside 0.9970 / 0.9932 / 0.9942; 0.55
-# inside the same as 0.5; 0.3 or 0.35 at the rim with 0.5 inside left the slot at
-# 0.9939 / 0.9940 with up to 182 such triangles.
-cdef double LATTICE_SNAP = 0.4
-cdef double LATTICE_SNAP_INNER = 0.5
 # A front turning by more than this (cosine below, about 20 degrees) at a boundary
 # vertex is at a corner: no curvature there.
 cdef double LATTICE_TURN_COS_MIN = 0.94
@@ -213,11 +208,14 @@ cdef int lattice_new_vertex(Aft* A, Tri* T, int v, int a, int b) noexcept nogil:
 
 cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogil:
     """Move R to the nearest lattice point when front edge e (under the constant size
-    h) is in a curved row and that point is near enough."""
+    h) joins two of Basic_aft's vertices in a curved row; A.lat_moved and A.lat_plain
+    say whether it moved and from where (basic_aft_step judges the plain R when the
+    lattice point is refused)."""
     cdef double kappa, x, y, i, j, px, py, d2, best = INFINITY, bx = 0.0, by = 0.0
     cdef double row = LATTICE_ROW * h
-    cdef double reach
     cdef int di, dj
+    if T.tv[e] < A.nv_input or T.tv[nxt(e)] < A.nv_input:
+        return
     kappa = 0.5 * (_kappa(A, T.tv[e]) + _kappa(A, T.tv[nxt(e)]))
     if not kappa * h > LATTICE_CURVED_MIN:
         return
@@ -235,9 +233,8 @@ cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogi
                 best = d2
                 bx = px
                 by = py
-    reach = LATTICE_SNAP
-    if T.tv[e] >= A.nv_input and T.tv[nxt(e)] >= A.nv_input:
-        reach = LATTICE_SNAP_INNER
-    if best < (reach * h) * (reach * h):
-        R[0] = A.lat_o[0] + bx
-        R[1] = A.lat_o[1] + by
+    A.lat_moved = True
+    A.lat_plain[0] = R[0]
+    A.lat_plain[1] = R[1]
+    R[0] = A.lat_o[0] + bx
+    R[1] = A.lat_o[1] + by

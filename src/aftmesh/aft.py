@@ -74,23 +74,39 @@ class Strategy:
 
 def basic_aft(kernel: Triangulation, strategy: Strategy) -> None:
     """Run Basic_aft on a kernel whose domain CDT is built (every domain triangle
-    unmeshed) and whose size field and options are set."""
+    unmeshed) and whose size field and options are set.
+
+    The built-in Compute_new_candidate may move R onto the lattice of converging rows
+    (``cython_ext/lattice.pxi``); when that point is refused, R where it first put
+    it is judged before S is taken, as in the compiled loop."""
     kernel.convert_to_frontal_edge_set()
+    builtin_candidate = type(strategy).compute_new_candidate is Strategy.compute_new_candidate
     while True:
         E = strategy.get_next_edge(kernel)
         if E < 0:
             break
         rx, ry, h = strategy.compute_new_candidate(kernel, E)
         S = kernel.compute_existing_candidate(E)
-        new = strategy.new_is_preferred(
-            kernel, E, (rx, ry), S, h
-        ) and not strategy.mesh_size_constraint(kernel, E, (rx, ry))
-        if new:
-            new, _left, _right = kernel.check_visible(E, rx, ry)
-            if new:
-                new = not strategy.is_crowded(kernel, E, (rx, ry), h)
+        new = _r_is_taken(kernel, strategy, E, (rx, ry), S, h)
+        plain = kernel.candidate_off_lattice() if builtin_candidate else None
+        if not new and plain is not None:
+            rx, ry = plain
+            new = _r_is_taken(kernel, strategy, E, (rx, ry), S, h)
         if new:
             t = kernel.update_internal(E, rx, ry)
         else:
             t = kernel.update_boundary(E)
         kernel.add_triangle(t)
+
+
+def _r_is_taken(
+    kernel: Triangulation, strategy: Strategy, E: int, R: tuple[float, float], S: int, h: float
+) -> bool:
+    """New_is_preferred and Mesh_size_constraint, then Check_visible and the proximity
+    rule: whether T(E, R) is made rather than T(E, S)."""
+    if not strategy.new_is_preferred(kernel, E, R, S, h):
+        return False
+    if strategy.mesh_size_constraint(kernel, E, R):
+        return False
+    visible, _left, _right = kernel.check_visible(E, R[0], R[1])
+    return bool(visible) and not strategy.is_crowded(kernel, E, R, h)
