@@ -710,9 +710,9 @@ cdef class Triangulation:
         return R[0], R[1], h
 
     def candidate_off_lattice(self):
-        """(x, y) of R as the last compute_new_candidate first put it, when it then
-        moved R onto the lattice of converging rows (cython_ext/lattice.pxi); None when
-        it did not."""
+        """(x, y) of the point the last compute_new_candidate computed before it moved
+        R onto the lattice of converging rows (cython_ext/lattice.pxi); None when it
+        did not move R."""
         if not self.A.lat_moved:
             return None
         return self.A.lat_plain[0], self.A.lat_plain[1]

@@ -776,7 +776,7 @@ cdef int basic_aft_step(Aft* A, Tri* T, int e) noexcept nogil:
             continue
         if not new and A.lat_moved:
             # the lattice point was refused (an earlier R took it, or it is not
-            # visible): judge R where Compute_new_candidate first put it
+            # visible): judge the point Compute_new_candidate computed before the move
             A.lat_moved = False
             R[0] = A.lat_plain[0]
             R[1] = A.lat_plain[1]

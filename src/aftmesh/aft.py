@@ -77,8 +77,8 @@ def basic_aft(kernel: Triangulation, strategy: Strategy) -> None:
     unmeshed) and whose size field and options are set.
 
     The built-in Compute_new_candidate may move R onto the lattice of converging rows
-    (``cython_ext/lattice.pxi``); when that point is refused, R where it first put
-    it is judged before S is taken, as in the compiled loop."""
+    (``cython_ext/lattice.pxi``); when that point is refused, the point it computed
+    before the move is judged before S is taken, as in the compiled loop."""
     kernel.convert_to_frontal_edge_set()
     builtin_candidate = type(strategy).compute_new_candidate is Strategy.compute_new_candidate
     while True:
