@@ -43,11 +43,12 @@ cdef struct Aft:
     int64_t n_scaffold_planted
     int64_t n_scaffold_kept     # could not be removed: ordinary vertices of the mesh
     int32_t crowd_scaffold  # the scaffold vertex is_crowded found too near R
-    # converging rows' lattice (lattice.pxi): whether rows may snap to it, its origin,
-    # whether the last Compute_new_candidate moved R onto it and R before the move,
-    # and the front's curvature at each vertex
+    # converging rows' lattice (lattice.pxi): whether rows may snap to it, its origin
+    # and the direction of its rows, whether the last Compute_new_candidate moved R
+    # onto it and R before the move, and the front's curvature at each vertex
     bint lat_on
     double lat_o[2]
+    double lat_dir[2]
     bint lat_moved
     double lat_plain[2]
     double* vkappa

@@ -8,13 +8,14 @@
 # stretch of the rim grows a lattice of its own orientation, so the inside of a disc is
 # a patchwork whose seams hold its poor triangles.  Instead, from the second row on
 # (an edge between two of Basic_aft's own vertices), R moves to the nearest point of
-# one equilateral lattice of the size (its rows along x, a point at the centroid of the
-# region the front encloses): the inside is one lattice, as in Gmsh's frontal-Delaunay
-# meshes of a disc, and the seam between the rows and the lattice is the first row.
-# R stays a candidate like any other: Lemma 3.1's test, Check_visible and the proximity
-# rules judge it as before, and where they refuse the lattice point (an earlier R took
-# it, or it is out of sight), basic_aft_step judges R where Compute_new_candidate first
-# put it before taking S.
+# one equilateral lattice of the size (a point at the centroid of the region the front
+# encloses, its rows along the longest straight side or else along x): the inside is
+# one lattice, as in Gmsh's frontal-Delaunay meshes of a disc, and the seam between
+# the rows and the lattice is the first row.  R stays a candidate like any other:
+# Lemma 3.1's test, Check_visible and the proximity rules judge it as before, and where
+# they refuse the lattice point (an earlier R took it, or it is out of sight),
+# basic_aft_step judges the point Compute_new_candidate computed before the move, and
+# only then takes S.
 #
 # Why so: over the 256-gon disc, an annulus and a slot, each turned by 0, 3, 11, 29,
 # 47 and 71 degrees, the mean radius ratio averaged 0.9927 / 0.9909 / 0.9939 with a
@@ -44,11 +45,11 @@
 # the condition, poly-A, poly-face and poly-double_hex3 lost 0.001-0.007 of mean radius
 # ratio, and with it their meshes are unchanged.
 #
-# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o, lat_moved, lat_plain, and
-# the size field's constant); triangulation.pxi (_grow).
+# Uses: halfedge.pxd; aft.pxd (Aft: vkappa, lat_on, lat_o, lat_dir, lat_moved,
+# lat_plain, and the size field's constant); triangulation.pxi (_grow).
 from halfedge cimport *
 from aft cimport Aft
-from libc.math cimport sqrt, floor, isfinite, INFINITY
+from libc.math cimport sqrt, floor, fabs, isfinite, INFINITY
 from libc.stdlib cimport malloc, free
 from libc.string cimport memset
 from libc.stdint cimport int32_t
@@ -62,6 +63,19 @@ cdef double LATTICE_CURVED_MIN = 0.002
 # A row's curvature grows as 1 / (1 - H kappa) from layer to layer (H the layer's
 # height); near its centre of curvature the factor is held at this at most.
 cdef double LATTICE_KAPPA_GROWTH_MAX = 2.0
+# The lattice's rows run along the longest straight stretch of boundary at least this
+# many sizes long, and along x without one.  The rows from a straight side then meet
+# the lattice in step: a slot with round ends went from 0.9952 to 0.9959 in mean radius
+# ratio over the six turns above (triangles at or below 0.9: 4-14 to 1-5); random
+# slots moved by +0.0005, +0.0005 and -0.0002 over three sets, boxes with round ends or
+# corners by 0 to +0.0001.  A polygon that stands for a curve has straight input edges
+# too: at 2 sizes they turned random ellipses' lattices to one of their edges, for
+# -0.0002 to +0.0003; from 8 up, ellipses and discs keep x and their meshes.
+cdef double LATTICE_ALIGN_RUN = 8.0
+# Joints straighter than this (the sine of the turn, about) continue a straight run:
+# the points that split an input edge lie on its line up to rounding (ARCHITECTURE.md's
+# rounding rules), and a curve's turns are far above.
+cdef double LATTICE_STRAIGHT_SINE = 1e-9
 # the height of an equilateral triangle of side 1
 cdef double LATTICE_ROW = 0.8660254037844386
 cdef enum:
@@ -119,6 +133,7 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
                 v = T.tv[e]
                 out[v] = e if out[v] == NONE else LATTICE_AMBIGUOUS
     _centroid_origin(A, T, into)
+    _align_with_longest_run(A, T, into, out)
     curved = False
     for v in range(T.nv):
         if into[v] >= 0 and out[v] >= 0:
@@ -162,6 +177,56 @@ cdef void _centroid_origin(Aft* A, Tri* T, const int32_t* into) noexcept nogil:
     if a2 > 0.0 and isfinite(cx / a2) and isfinite(cy / a2):
         A.lat_o[0] = ox + cx / (3.0 * a2)
         A.lat_o[1] = oy + cy / (3.0 * a2)
+
+
+cdef bint _straight_at(Tri* T, int e, int f) noexcept nogil:
+    # edge e ends where edge f starts, and f goes on in e's direction (within
+    # LATTICE_STRAIGHT_SINE)
+    cdef const double* pa = P(T, T.tv[e])
+    cdef const double* pb = P(T, T.tv[f])
+    cdef const double* pc = P(T, T.tv[nxt(f)])
+    cdef double ux = pb[0] - pa[0], uy = pb[1] - pa[1]
+    cdef double vx = pc[0] - pb[0], vy = pc[1] - pb[1]
+    cdef double c = ux * vy - uy * vx
+    return (ux * vx + uy * vy > 0.0
+            and fabs(c) <= LATTICE_STRAIGHT_SINE * (ux * ux + uy * uy + vx * vx + vy * vy))
+
+
+cdef void _align_with_longest_run(Aft* A, Tri* T, const int32_t* into,
+                                  const int32_t* out) noexcept nogil:
+    """A.lat_dir: the direction of the longest straight run of front edges (a
+    straight side, split or not), when it is at least LATTICE_ALIGN_RUN sizes long;
+    x otherwise.  Each run is walked once, from its first edge."""
+    cdef int v, e, w, n
+    cdef double best = 0.0, dx, dy, L
+    cdef const double* p0
+    cdef const double* p1
+    A.lat_dir[0] = 1.0
+    A.lat_dir[1] = 0.0
+    for v in range(T.nv):
+        e = out[v]
+        if e < 0:
+            continue
+        # a run starts at v unless the edge into v goes straight on into e
+        if into[v] >= 0 and _straight_at(T, into[v], e):
+            continue
+        w = T.tv[nxt(e)]
+        n = 0
+        while n < T.nv and out[w] >= 0 and into[w] >= 0 and _straight_at(T, into[w], out[w]):
+            w = T.tv[nxt(out[w])]
+            n += 1
+        p0 = P(T, v)
+        p1 = P(T, w)
+        dx = p1[0] - p0[0]
+        dy = p1[1] - p0[1]
+        L = sqrt(dx * dx + dy * dy)
+        if L > best:
+            best = L
+            A.lat_dir[0] = dx / L
+            A.lat_dir[1] = dy / L
+    if best < LATTICE_ALIGN_RUN * A.size.constant:
+        A.lat_dir[0] = 1.0
+        A.lat_dir[1] = 0.0
 
 
 cdef double _turn_per_length(Tri* T, int e, int f) noexcept nogil:
@@ -219,8 +284,8 @@ cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogi
     kappa = 0.5 * (_kappa(A, T.tv[e]) + _kappa(A, T.tv[nxt(e)]))
     if not kappa * h > LATTICE_CURVED_MIN:
         return
-    x = R[0] - A.lat_o[0]
-    y = R[1] - A.lat_o[1]
+    x = A.lat_dir[0] * (R[0] - A.lat_o[0]) + A.lat_dir[1] * (R[1] - A.lat_o[1])
+    y = -A.lat_dir[1] * (R[0] - A.lat_o[0]) + A.lat_dir[0] * (R[1] - A.lat_o[1])
     j = floor(y / row + 0.5)
     i = floor(x / h - 0.5 * j + 0.5)
     # the rounding above can miss the nearest point by one: try the neighbours too
@@ -236,5 +301,5 @@ cdef void lattice_snap(Aft* A, Tri* T, int e, double* R, double h) noexcept nogi
     A.lat_moved = True
     A.lat_plain[0] = R[0]
     A.lat_plain[1] = R[1]
-    R[0] = A.lat_o[0] + bx
-    R[1] = A.lat_o[1] + by
+    R[0] = A.lat_o[0] + A.lat_dir[0] * bx - A.lat_dir[1] * by
+    R[1] = A.lat_o[1] + A.lat_dir[1] * bx + A.lat_dir[0] * by
