@@ -15,9 +15,8 @@
 # stale entries are simply skipped (lazy deletion).
 #
 # Uses: halfedge.pxd; aft.pxd (Aft, QueueItem); sizing.pxi (size_at); lattice.pxi;
-# predicates.pxi;
-# triangulation.pxi (find_edge, insert_vertex_at, add_vertex, legalize_meshed,
-# reserve_stack, _grow); cdt.pxi (insert_segment).
+# predicates.pxi; triangulation.pxi (find_edge, insert_vertex_at, add_vertex,
+# legalize_meshed, reserve_stack, _grow); cdt.pxi (insert_segment).
 from halfedge cimport *
 from aft cimport Aft, QueueItem
 from libc.math cimport sqrt, floor, log2, fabs

@@ -103,9 +103,10 @@ cdef inline double _kappa(const Aft* A, int v) noexcept nogil:
 
 cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
     """With the frontal edge set just made: whether rows may snap (one constant size,
-    New_is_preferred in use, a curved stretch of boundary), the lattice's origin, and
-    each front vertex's curvature, from the front edges into and out of it (none where
-    a vertex has two of either: rings touching there)."""
+    New_is_preferred in use, a curved stretch of boundary), each front vertex's
+    curvature, from the front edges into and out of it (none where a vertex has two of
+    either: rings touching there), and, when rows may snap, the lattice's origin and
+    the direction of its rows."""
     cdef int t, k, e, v
     cdef bint curved
     cdef int32_t* into
@@ -132,13 +133,14 @@ cdef int lattice_start(Aft* A, Tri* T) noexcept nogil:
                 into[v] = e if into[v] == NONE else LATTICE_AMBIGUOUS
                 v = T.tv[e]
                 out[v] = e if out[v] == NONE else LATTICE_AMBIGUOUS
-    _centroid_origin(A, T, into)
-    _align_with_longest_run(A, T, into, out)
     curved = False
     for v in range(T.nv):
         if into[v] >= 0 and out[v] >= 0:
             A.vkappa[v] = _turn_per_length(T, into[v], out[v])
             curved = curved or A.vkappa[v] * A.size.constant > LATTICE_CURVED_MIN
+    if curved:
+        _centroid_origin(A, T, into)
+        _align_with_longest_run(A, T, into, out)
     free(into)
     # without a curved stretch of boundary no row ever snaps: then the loop skips
     # the lattice's bookkeeping altogether (the unit square at size 0.01 ran 0.8 % more
@@ -179,17 +181,26 @@ cdef void _centroid_origin(Aft* A, Tri* T, const int32_t* into) noexcept nogil:
         A.lat_o[1] = oy + cy / (3.0 * a2)
 
 
-cdef bint _straight_at(Tri* T, int e, int f) noexcept nogil:
-    # edge e ends where edge f starts, and f goes on in e's direction (within
-    # LATTICE_STRAIGHT_SINE)
+cdef inline void _joint(Tri* T, int e, int f, double* u, double* w) noexcept nogil:
+    # where edge e ends and edge f starts: u = e's vector, w = f's
     cdef const double* pa = P(T, T.tv[e])
     cdef const double* pb = P(T, T.tv[f])
     cdef const double* pc = P(T, T.tv[nxt(f)])
-    cdef double ux = pb[0] - pa[0], uy = pb[1] - pa[1]
-    cdef double vx = pc[0] - pb[0], vy = pc[1] - pb[1]
-    cdef double c = ux * vy - uy * vx
-    return (ux * vx + uy * vy > 0.0
-            and fabs(c) <= LATTICE_STRAIGHT_SINE * (ux * ux + uy * uy + vx * vx + vy * vy))
+    u[0] = pb[0] - pa[0]
+    u[1] = pb[1] - pa[1]
+    w[0] = pc[0] - pb[0]
+    w[1] = pc[1] - pb[1]
+
+
+cdef bint _straight_at(Tri* T, int e, int f) noexcept nogil:
+    # edge e ends where edge f starts, and f goes on in e's direction (within
+    # LATTICE_STRAIGHT_SINE)
+    cdef double u[2]
+    cdef double w[2]
+    _joint(T, e, f, u, w)
+    return (u[0] * w[0] + u[1] * w[1] > 0.0
+            and fabs(u[0] * w[1] - u[1] * w[0])
+            <= LATTICE_STRAIGHT_SINE * (u[0] * u[0] + u[1] * u[1] + w[0] * w[0] + w[1] * w[1]))
 
 
 cdef void _align_with_longest_run(Aft* A, Tri* T, const int32_t* into,
@@ -232,15 +243,15 @@ cdef void _align_with_longest_run(Aft* A, Tri* T, const int32_t* into,
 cdef double _turn_per_length(Tri* T, int e, int f) noexcept nogil:
     """The front's curvature where edge e ends and edge f starts: the turn's sine over
     the mean of the two lengths, or 0 at a corner."""
-    cdef const double* pa = P(T, T.tv[e])
-    cdef const double* pb = P(T, T.tv[f])
-    cdef const double* pc = P(T, T.tv[nxt(f)])
-    cdef double ux = pb[0] - pa[0], uy = pb[1] - pa[1]
-    cdef double vx = pc[0] - pb[0], vy = pc[1] - pb[1]
-    cdef double lu = sqrt(ux * ux + uy * uy), lv = sqrt(vx * vx + vy * vy)
-    if not (lu > 0.0 and lv > 0.0) or ux * vx + uy * vy < LATTICE_TURN_COS_MIN * lu * lv:
+    cdef double u[2]
+    cdef double w[2]
+    cdef double lu, lw
+    _joint(T, e, f, u, w)
+    lu = sqrt(u[0] * u[0] + u[1] * u[1])
+    lw = sqrt(w[0] * w[0] + w[1] * w[1])
+    if not (lu > 0.0 and lw > 0.0) or u[0] * w[0] + u[1] * w[1] < LATTICE_TURN_COS_MIN * lu * lw:
         return 0.0
-    return 2.0 * (ux * vy - uy * vx) / (lu * lv * (lu + lv))
+    return 2.0 * (u[0] * w[1] - u[1] * w[0]) / (lu * lw * (lu + lw))
 
 
 cdef int lattice_new_vertex(Aft* A, Tri* T, int v, int a, int b) noexcept nogil:
