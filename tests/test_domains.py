@@ -4,6 +4,7 @@ every accepted form gives a valid mesh of the right domain; every bad input rais
 
 from __future__ import annotations
 
+import pickle
 import re
 
 import domain_cases as dc
@@ -662,6 +663,29 @@ def test_crossing_segments_named():
         aftmesh.generate(d, split_boundary=False)
     assert set(err.value.segments) == {0, 1}
     assert "segments[0]" in str(err.value) and "segments[1]" in str(err.value)
+
+
+def test_dict_sources_are_named_by_position_without_a_string_each():
+    """A dict's sources are its segments, named ``segments[i]``: info["sources"]
+    reads like that list (index, slice, equality, numpy, pickle) but holds no string
+    per segment, which a call on a large input would otherwise pay for."""
+    d = dict(
+        vertices=[(0, 0), (1, 0), (1, 1), (0, 1)],
+        segments=[(0, 1), (1, 2), (2, 3), (3, 0)],
+    )
+    mesh = valid(aftmesh.generate(d, 0.3), 1.0)
+    names = mesh.info["sources"]
+    listed = [f"segments[{i}]" for i in range(4)]
+    assert names == listed and listed == names and list(names) == listed
+    assert names[-1] == "segments[3]" and names[1:3] == listed[1:3]
+    assert np.array(names)[mesh.segment_markers].tolist() == [
+        listed[k] for k in mesh.segment_markers
+    ]
+    assert pickle.loads(pickle.dumps(names)) == listed
+    assert names != listed[:3] and names != "segments[0]"
+    with pytest.raises(IndexError, match="source 4"):
+        names[4]
+    assert not hasattr(names, "__dict__")  # two fields, whatever the input's size
 
 
 def test_regression_crossing_error_names_input_segments():

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .domain_record import PositionalNames
 from .errors import InvalidInputError
 from .io_poly import write_mesh_poly, write_node_ele
 
@@ -82,7 +83,11 @@ def _marker_names(mesh) -> dict[int, str]:
     names its sources ``segments[i]`` by position, and its markers may be the user's
     own numbers rather than those positions, so they get no name from it."""
     sources = mesh.info.get("sources") if isinstance(mesh.info, dict) else None
-    if not sources or all(name == f"segments[{i}]" for i, name in enumerate(sources)):
+    if (
+        not sources
+        or isinstance(sources, PositionalNames)
+        or all(name == f"segments[{i}]" for i, name in enumerate(sources))
+    ):
         return {}
     return {i: str(name) for i, name in enumerate(sources)}
 

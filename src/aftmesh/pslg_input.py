@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._typing import PathArg
-from .domain_record import Domain
+from .domain_record import Domain, PositionalNames
 from .errors import InvalidInputError
 from .noding import merge_close_segments, refuse_crossings, split_at_vertices
 from .pslg import as_points, as_segments
@@ -65,7 +65,7 @@ def from_dict(d: dict, presplit: bool = True, tolerance: float = 0.0) -> Domain:
     holes = as_points(d.get("holes", np.zeros((0, 2))), "holes")
     reg = _dict_regions(d.get("regions"))
     markers = _dict_markers(d.get("segment_markers"), len(seg))
-    names = [f"segments[{i}]" for i in range(len(seg))]
+    names = PositionalNames("segments", len(seg))
     mids = 0.5 * (pts[seg[:, 0]] + pts[seg[:, 1]])
     edges = np.arange(len(seg), dtype=np.int32)
     note: list[str] = []
