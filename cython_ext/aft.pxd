@@ -20,6 +20,10 @@ cdef struct Aft:
     int queue_n          # items queued
     int items_n, items_cap, free_item
     int low_class       # no class below this one holds an item
+    # the initial front (the edges on the input segments), in the queue's order, taken
+    # before any queued edge: first[first_pos:first_n] are still to come (front.pxi)
+    QueueItem* first
+    int first_n, first_pos
     int used_low, used_high     # the classes used since the queue was last emptied
     int order
     SizeField size

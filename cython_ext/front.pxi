@@ -80,6 +80,7 @@ cdef int aft_init(Aft* A) noexcept nogil:
 
 cdef void aft_free(Aft* A) noexcept nogil:
     free(A.items)
+    free(A.first)
     free(A.head)
     free(A.tail)
     free(A.left)
@@ -93,7 +94,8 @@ cdef void aft_free(Aft* A) noexcept nogil:
 # ---------------------------------------------------------------- the queue
 #
 # Get_next_edge takes the front edge of the smallest length class, the oldest within a
-# class (or the longest class first, or plain first in first out: A.order).  Classes
+# class, after the initial front (see _queue_initial_first); or the longest class
+# first, or plain first in first out (A.order).  Classes
 # are small integers, so the queue is one first-in first-out list per class: pushing
 # and popping cost O(1), where a binary heap's sifting cost a tenth of the run time.
 
@@ -135,6 +137,8 @@ cdef void queue_clear(Aft* A) noexcept nogil:
     A.items_n = 0
     A.free_item = -1
     A.low_class = QUEUE_CLASSES
+    A.first_n = 0
+    A.first_pos = 0
 
 
 # 2**(1/4), 2**(1/2), 2**(3/4): the mantissa's class boundaries (_quarter_octaves)
@@ -225,8 +229,15 @@ cdef int queue_push(Aft* A, Tri* T, int e) noexcept nogil:
 
 
 cdef void queue_pop(Aft* A, QueueItem* out) noexcept nogil:
-    """Take the oldest item of the lowest class holding one (A.queue_n > 0)."""
+    """Take the next edge of the initial front while there is one (see
+    _queue_initial_first), else the oldest item of the lowest class holding one
+    (A.queue_n > 0)."""
     cdef int c = A.low_class, i
+    if A.first_pos < A.first_n:
+        out[0] = A.first[A.first_pos]
+        A.first_pos += 1
+        A.queue_n -= 1
+        return
     while A.head[c] < 0:
         c += 1
     A.low_class = c
@@ -255,8 +266,9 @@ cdef inline double _tri_area(Tri* T, int t) noexcept nogil:
 
 cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
     """C = every constrained half-edge of an unmeshed triangle (the domain's CDT has
-    been built and carved).  Also counts the triangles for formula (4), and starts
-    the converging rows' lattice (lattice.pxi)."""
+    been built and carved), queued to be taken first (_queue_initial_first).  Also
+    counts the triangles for formula (4), and starts the converging rows' lattice
+    (lattice.pxi)."""
     cdef int t, k
     queue_clear(A)
     A.nv_input = T.nv
@@ -274,7 +286,44 @@ cdef int convert_to_frontal_edge_set(Aft* A, Tri* T) noexcept nogil:
                 if blocking(T, 3 * t + k):
                     if queue_push(A, T, 3 * t + k):
                         return ERR_NOMEM
+    if _queue_initial_first(A):
+        return ERR_NOMEM
     return lattice_start(A, T)
+
+
+# With the shortest-first order, the initial front (the edges on the input segments,
+# the first row along the boundary) is taken whole, shortest first, before any edge a
+# step made.  Taken by length with the rest, a boundary edge waits for every shorter
+# front edge: the rows growing from short input edges (a small island, a staircase's
+# steps, a concave corner) reach a longer boundary before its own first row exists,
+# and meet its fixed vertices, which smoothing can only slide along their segment;
+# with that row in place they meet free vertices instead.  The real-world group's mean
+# radius ratio rose from 0.9661 to 0.9669 and its share above 0.9 from 92.97 % to
+# 93.63 %, with 3 % fewer triangles (rw-earcut-hilbert +0.0034, rw-river +0.0028 with
+# 15 % fewer, rw-city +0.0025; rw-earcut-water-huge2 -0.0011); random discs, ellipses,
+# slots and rounded boxes went from 80.9 to 50.1 triangles at or below 0.9 a domain.
+# The graded airfoil (naca0012) lost 0.0012 with 7 % more triangles: the rows on its
+# chord now grow before the leading edge's fronts spread over them.  Giving the
+# boundary's edges a head start of one to four octaves of length instead did about
+# as well (0.9668-0.9669); a quarter or half an octave, less (0.9665, 0.9667).
+
+
+cdef int _queue_initial_first(Aft* A) noexcept nogil:
+    """Move the queued edges (the initial front) into A.first in the queue's order;
+    queue_pop hands them out before anything queued later.  0 or ERR_NOMEM."""
+    cdef int n = A.queue_n, i
+    if n == 0 or A.order != ORDER_SHORTEST:
+        return 0
+    free(A.first)
+    A.first = <QueueItem*> malloc(n * sizeof(QueueItem))
+    if A.first == NULL:
+        return ERR_NOMEM
+    for i in range(n):
+        queue_pop(A, &A.first[i])
+    A.first_n = n
+    A.first_pos = 0
+    A.queue_n = n
+    return 0
 
 
 cdef int get_next_edge(Aft* A, Tri* T) noexcept nogil:

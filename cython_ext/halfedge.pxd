@@ -60,7 +60,9 @@ cdef enum Location:     # results of locate()
     LOC_OUTSIDE = 3     # strictly outside the convex hull: the answer is a ghost triangle
 
 cdef enum Order:        # Get_next_edge's order of the heap
-    ORDER_SHORTEST = 0  # shortest front edge first (length classes, oldest within one)
+    # the initial front (shortest first), then the shortest front edge first (length
+    # classes, oldest within one)
+    ORDER_SHORTEST = 0
     ORDER_LONGEST = 1
     ORDER_OLDEST = 2    # first in, first out
 

@@ -153,8 +153,10 @@ def generate(
         A_min: no new vertex whose triangle would be smaller (formula (5)).  By default
         1 % of the area of an equilateral triangle of the smallest size.
     order : {'shortest', 'longest', 'oldest'}
-        Get_next_edge: shortest front edge first (default), longest first, or oldest
-        first (layer by layer).
+        Get_next_edge: shortest front edge first (default; the edges on the input
+        segments, shortest first, come before every edge made since, so the first
+        row along the whole boundary is in place before rows from elsewhere reach
+        it), longest first, or oldest first (layer by layer).
     greedy : bool
         New_is_preferred always false: no point is added and the result is a
         triangulation of the (discretized) input vertices.
