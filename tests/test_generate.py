@@ -543,6 +543,40 @@ def test_seams_where_two_lattices_meet_stay_narrow(checked):
 
 
 # ------------------------------------------------------ compiled loop vs Python loop
+class _FrontOrder(Strategy):
+    """The built-in subtasks, recording each edge Get_next_edge hands out."""
+
+    def __init__(self):
+        self.edges = []
+
+    def get_next_edge(self, kernel):
+        E = super().get_next_edge(kernel)
+        if E >= 0:
+            a, b = kernel.edge(E)
+            self.edges.append((kernel.vertex(a), kernel.vertex(b)))
+        return E
+
+
+def test_the_first_row_along_the_boundary_comes_first():
+    """Get_next_edge (shortest first) hands out the edges on the input segments,
+    shortest first, before any edge a step made: the rows from a small hole's short
+    edges used to run ahead of the long outer edges' own first row."""
+    domain = box(0, 0, 2, 1).difference(Point(0.15, 0.5).buffer(0.02, 8))
+    rec = _FrontOrder()
+    aftmesh.generate(domain, 0.1, strategy=rec, smooth=0, min_angle=None)
+    outline = domain.boundary
+    on_boundary = [
+        outline.distance(Point(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]))) < 1e-12
+        for a, b in rec.edges
+    ]
+    first = on_boundary.index(False)
+    assert first > 20 and not any(on_boundary[first:])
+    lengths = [math.dist(a, b) for a, b in rec.edges[:first]]
+    # length classes are eighths of an octave: a later edge is never a class shorter
+    assert all(m >= l * 2 ** (-1 / 8) * (1 - 1e-9) for l, m in zip(lengths, lengths[1:]))
+    assert lengths[0] < 0.02 < 0.09 < lengths[-1]
+
+
 class SameGetNextEdge(Strategy):
     def get_next_edge(self, kernel):
         return kernel.get_next_edge()
@@ -827,40 +861,6 @@ def test_lattice_rows_follow_the_longest_straight_side(checked, turn):
     slot = affinity.rotate(LineString([(0, 0), (2, 0)]).buffer(0.5, 32), turn, origin=(0.1, 0.2))
     mesh = checked(aftmesh.generate(slot, 0.03), domain_area=slot.area)
     assert mesh.quality()["radius_ratio_mean"] > 0.9955
-
-
-class _FrontOrder(Strategy):
-    """The built-in subtasks, recording each edge Get_next_edge hands out."""
-
-    def __init__(self):
-        self.edges = []
-
-    def get_next_edge(self, kernel):
-        E = super().get_next_edge(kernel)
-        if E >= 0:
-            a, b = kernel.edge(E)
-            self.edges.append((kernel.vertex(a), kernel.vertex(b)))
-        return E
-
-
-def test_the_first_row_along_the_boundary_comes_first():
-    """Get_next_edge (shortest first) hands out the edges on the input segments,
-    shortest first, before any edge a step made: the rows from a small hole's short
-    edges used to run ahead of the long outer edges' own first row."""
-    domain = box(0, 0, 2, 1).difference(Point(0.15, 0.5).buffer(0.02, 8))
-    rec = _FrontOrder()
-    aftmesh.generate(domain, 0.1, strategy=rec, smooth=0, min_angle=None)
-    outline = domain.boundary
-    on_boundary = [
-        outline.distance(Point(0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1]))) < 1e-12
-        for a, b in rec.edges
-    ]
-    first = on_boundary.index(False)
-    assert first > 20 and not any(on_boundary[first:])
-    lengths = [math.dist(a, b) for a, b in rec.edges[:first]]
-    # length classes are eighths of an octave: a later edge is never a class shorter
-    assert all(m >= l * 2 ** (-1 / 8) * (1 - 1e-9) for l, m in zip(lengths, lengths[1:]))
-    assert lengths[0] < 0.02 < 0.09 < lengths[-1]
 
 
 @pytest.mark.parametrize(
