@@ -169,11 +169,119 @@ def reference_area(case) -> float | None:
         return None
 
 
+# Each mesher's timed runs of a case are split over this many workers (at most one a
+# run), which take turns with the other meshers' in rotating order: a burst of load
+# on a shared machine then weighs on a few runs of each mesher, where one worker
+# running all of one mesher's repeats back to back could slow every one of them.
+TIMING_PASSES = 3
+
+
+def split_repeats(repeat: int, passes: int) -> list[int]:
+    """``repeat`` runs over at most ``passes`` workers, the earlier ones taking the
+    remainder: ``split_repeats(5, 3) == [2, 2, 1]``."""
+    passes = max(1, min(passes, repeat))
+    return [repeat // passes + (k < repeat % passes) for k in range(passes)]
+
+
+def _mesh_job(cname: str, mname: str, repeat: int, quick: bool, timing_only: bool) -> dict:
+    job = {
+        "kind": "mesh",
+        "case": cname,
+        "mesher": mname,
+        "repeat": repeat,
+        "min_repeat": 1 if quick else min(repeat, 5),
+        "budget": 0.25 if quick else 60.0,
+        "edges": True,
+        "timing_only": timing_only,
+    }
+    return run_job(job, timeout=120 if quick else 1200)
+
+
+def _case_meta(case) -> dict:
+    return {
+        "description": case.description,
+        "vertices": len(case.vertices),
+        "segments": len(case.segments),
+        "holes": len(case.holes),
+        "notes": case.notes,
+        "area": reference_area(case),
+    }
+
+
+def _first_pass(cname, mesher_names, repeat, quick, gmsh_limit, log) -> list[dict]:
+    """Every mesher's full job on the case (result, memory, quality, first runs)."""
+    rows: list[dict] = []
+    aft_triangles = None
+    for mname in mesher_names:
+        row = {"case": cname, "mesher": mname}
+        rows.append(row)
+        why = mesher_available(mname)
+        if why:
+            row["error"] = f"not available ({why})"
+            continue
+        if mname.startswith("gmsh") and aft_triangles is not None and aft_triangles > gmsh_limit:
+            row["skipped"] = (
+                f"skipped: about {aft_triangles:.2g} triangles > gmsh limit "
+                f"{gmsh_limit:.2g} (--gmsh-limit)"
+            )
+            log(f"  {cname:18s} {mname:14s} {row['skipped']}")
+            continue
+        row.update(_mesh_job(cname, mname, repeat, quick, timing_only=False))
+        if "times" not in row:
+            log(f"  {cname:18s} {mname:14s} ERROR {row.get('error')}")
+        elif mname == "aft":
+            aft_triangles = row["stats"]["triangles"]
+    return rows
+
+
+def _later_passes(cname, rows: list[dict], counts: list[int], quick, log) -> None:
+    """The other passes' timed runs, appended to the rows that have a result; the
+    meshers' order rotates by one each pass."""
+    live = [r for r in rows if "times" in r]
+    for k, repeat in enumerate(counts[1:], start=1):
+        turn = k % len(live) if live else 0
+        for row in live[turn:] + live[:turn]:
+            res = _mesh_job(cname, row["mesher"], repeat, quick, timing_only=True)
+            if "times" not in res:
+                log(f"  {cname:18s} {row['mesher']:14s} pass {k + 1}: ERROR {res.get('error')}")
+                continue
+            for key in ("times", "cpu", "internal_timings"):
+                row[key] = row.get(key, []) + res[key]
+            row["wall"] = row.get("wall", 0.0) + res["wall"]
+
+
+def _finish_rows(cname: str, rows: list[dict], log) -> None:
+    """Medians, triangle counts and the ratios to the reference mesher."""
+    from .worker import median_timing
+
+    for row in rows:
+        if "times" not in row:
+            continue
+        row["median"] = _median(row["times"])
+        row["cpu_median"] = _median(row["cpu"])
+        row["triangles"] = row["stats"]["triangles"]
+        row["internal_timing"] = median_timing(row.get("internal_timings", []))
+        row["tri_per_s"] = row["triangles"] / row["median"]
+        log(
+            f"  {cname:18s} {row['mesher']:14s} {row['triangles']:>9d} tri  "
+            f"{row['median']:.4f} s  ({len(row['times'])} runs)"
+        )
+    ref = next((r for r in rows if r["mesher"] == REFERENCE and r.get("median")), None)
+    for row in rows:
+        if ref and row.get("median"):
+            row["time_ratio"] = row["median"] / ref["median"]
+            row["rate_ratio"] = row["tri_per_s"] / ref["tri_per_s"]
+            row["cpu_ratio"] = row["cpu_median"] / ref["cpu_median"]
+
+
 def run_mesh_suite(
     case_names, mesher_names, *, quick: bool, repeat: int, gmsh_limit: float, log=print
 ) -> dict:
+    """Mesh every case with every mesher: a first pass of full jobs, then (unless
+    quick) TIMING_PASSES - 1 passes of timed runs only, taking turns."""
     rows = []
     cases_meta = {}
+    counts = split_repeats(repeat, 1 if quick else TIMING_PASSES)
     for cname in case_names:
         try:
             case = build_case(cname)
@@ -181,74 +289,11 @@ def run_mesh_suite(
             log(f"  {cname}: cannot build: {exc}")
             rows.append({"case": cname, "mesher": "-", "error": f"case: {exc}"})
             continue
-        cases_meta[cname] = {
-            "description": case.description,
-            "vertices": len(case.vertices),
-            "segments": len(case.segments),
-            "holes": len(case.holes),
-            "notes": case.notes,
-            "area": reference_area(case),
-        }
-        aft_triangles = None
-        for mname in mesher_names:
-            row = {"case": cname, "mesher": mname}
-            why = mesher_available(mname)
-            if why:
-                row["error"] = f"not available ({why})"
-                rows.append(row)
-                continue
-            if (
-                mname.startswith("gmsh")
-                and aft_triangles is not None
-                and aft_triangles > gmsh_limit
-            ):
-                row["skipped"] = (
-                    f"skipped: about {aft_triangles:.2g} triangles > gmsh limit "
-                    f"{gmsh_limit:.2g} (--gmsh-limit)"
-                )
-                rows.append(row)
-                log(f"  {cname:18s} {mname:14s} {row['skipped']}")
-                continue
-            job = {
-                "kind": "mesh",
-                "case": cname,
-                "mesher": mname,
-                "repeat": repeat,
-                "min_repeat": 1 if quick else min(repeat, 5),
-                "budget": 0.25 if quick else 60.0,
-                "edges": True,
-            }
-            res = run_job(job, timeout=120 if quick else 1200)
-            row.update(res)
-            if "times" in res:
-                row["median"] = _median(res["times"])
-                row["cpu_median"] = _median(res["cpu"])
-                row["triangles"] = res["stats"]["triangles"]
-                if mname == "aft":
-                    aft_triangles = row["triangles"]
-                log(
-                    f"  {cname:18s} {mname:14s} {row['triangles']:>9d} tri  "
-                    f"{row['median']:.4f} s  ({len(res['times'])} runs)"
-                )
-            else:
-                log(f"  {cname:18s} {mname:14s} ERROR {res.get('error')}")
-            rows.append(row)
-        ref = next(
-            (
-                r
-                for r in rows
-                if r["case"] == cname and r["mesher"] == REFERENCE and r.get("median")
-            ),
-            None,
-        )
-        mine = [r for r in rows if r["case"] == cname and r.get("median")]
-        for r in mine:
-            r["tri_per_s"] = r["triangles"] / r["median"]
-        for r in mine:
-            if ref:
-                r["time_ratio"] = r["median"] / ref["median"]
-                r["rate_ratio"] = r["tri_per_s"] / ref["tri_per_s"]
-                r["cpu_ratio"] = r["cpu_median"] / ref["cpu_median"]
+        cases_meta[cname] = _case_meta(case)
+        case_rows = _first_pass(cname, mesher_names, counts[0], quick, gmsh_limit, log)
+        _later_passes(cname, case_rows, counts, quick, log)
+        _finish_rows(cname, case_rows, log)
+        rows += case_rows
     return {
         "rows": rows,
         "cases": cases_meta,

@@ -3,7 +3,9 @@
 Prints one line ``@@RESULT <json>`` at the end.  Jobs:
 
 * ``{"kind": "mesh", "case", "mesher", "repeat", "min_repeat", "budget", "edges"}``,
-  with ``"own_cdt": true`` (aftmesh) also timing ``aftmesh.cdt`` of its own output
+  with ``"own_cdt": true`` (aftmesh) also timing ``aftmesh.cdt`` of its own output,
+  or with ``"timing_only": true`` only the timed runs, after an untimed one (a later
+  pass of runner.py's, which takes turns with the other meshers)
 * ``{"kind": "cdt-speed", "sizes", "repeat", "constrained", "tools"}``
 * ``{"kind": "cdt-mem", "tool", "n"}``
 """
@@ -29,19 +31,56 @@ def _emit(obj) -> None:
 # ----------------------------------------------------------------------- meshing
 
 
-def mesh_job(job: dict) -> dict:
+def _prepared(job: dict):
+    """The job's case and its mesher, warmed up on a tiny square (which loads lazily
+    imported code and initialises Gmsh)."""
     from .cases import build_case, square
-    from .measure import MemoryProbe, quality_stats
     from .meshers import prepare
 
     case = build_case(job["case"])
-    name = job["mesher"]
-    # warm-up on a tiny square: loads lazily imported code, initialises Gmsh
-    tiny = prepare(name, square(0.1))
+    tiny = prepare(job["mesher"], square(0.1))
     tiny.result(tiny.run())
     del tiny
+    return case, prepare(job["mesher"], case)
 
-    runner = prepare(name, case)
+
+def _timed_runs(runner, job: dict, times: list, cpu: list, timings: list) -> None:
+    """More timed runs, until ``repeat`` in all, or ``budget`` seconds once there
+    are ``min_repeat``."""
+    started = time.perf_counter()
+    while len(times) < job["repeat"]:
+        if len(times) >= job["min_repeat"] and time.perf_counter() - started > job["budget"]:
+            break
+        runner.reset()
+        gc.collect()
+        c0 = time.process_time()
+        t0 = time.perf_counter()
+        raw = runner.run()
+        times.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+        timings.append(_internal_timing(raw))
+        del raw
+
+
+def timing_job(job: dict) -> dict:
+    """Only timed runs (see the module's docstring), after one untimed run of the
+    case: every run timed here is a repeat, like all but the first of mesh_job's."""
+    _, runner = _prepared(job)
+    runner.run()
+    times: list = []
+    cpu: list = []
+    timings: list = []
+    _timed_runs(runner, job, times, cpu, timings)
+    runner.close()
+    return {"times": times, "cpu": cpu, "internal_timings": timings}
+
+
+def mesh_job(job: dict) -> dict:
+    from .measure import MemoryProbe, quality_stats
+
+    if job.get("timing_only"):
+        return timing_job(job)
+    case, runner = _prepared(job)
     probe = MemoryProbe()
     probe.start()
     c0 = time.process_time()
@@ -61,24 +100,9 @@ def mesh_job(job: dict) -> dict:
     # mesh is freed before the timed runs) for the own-output CDT below
     own_input = _own_cdt_input(raw) if job.get("own_cdt") else None
     del raw, out
-    started = time.perf_counter()
-    while len(times) < job["repeat"]:
-        if len(times) >= job["min_repeat"] and time.perf_counter() - started > job["budget"]:
-            break
-        runner.reset()
-        gc.collect()
-        c0 = time.process_time()
-        t0 = time.perf_counter()
-        raw = runner.run()
-        times.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-        timings.append(_internal_timing(raw))
-        del raw
+    _timed_runs(runner, job, times, cpu, timings)
     own = own_cdt_times(*own_input, len(times)) if own_input is not None else None
     runner.close()
-    internal = None
-    if all(timings):
-        internal = {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
     result = {
         "times": times,
         "cpu": cpu,
@@ -86,7 +110,8 @@ def mesh_job(job: dict) -> dict:
         "mem_method": probe.method,
         "stats": stats,
         "passes": passes,
-        "internal_timing": internal,
+        "internal_timings": timings,
+        "internal_timing": median_timing(timings),
     }
     if own is not None:
         result["own_cdt"] = own
@@ -113,6 +138,14 @@ def own_cdt_times(points: np.ndarray, segments: np.ndarray, repeat: int) -> dict
         times.append(time.perf_counter() - t0)
         cpu.append(time.process_time() - c0)
     return {"times": times, "cpu": cpu}
+
+
+def median_timing(timings: list) -> dict | None:
+    """Per stage, the median of the runs' internal timings (None unless every run
+    has them)."""
+    if not timings or not all(timings):
+        return None
+    return {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
 
 
 def _internal_timing(raw):
