@@ -11,8 +11,10 @@ time, Triangle's and their ratio, that ratio per triangle made (the two make
 different counts from the same boundary and size), and the per-stage breakdown
 (generate's ``info["timing"]``).
 
-Times are process CPU time unless marked wall; run it on a quiet machine, and
-alternate runs when comparing two versions.  Nothing here is asserted.
+Times are process CPU time unless marked wall.  aftmesh and Triangle are timed call
+by call in turns, so a burst of load on a shared machine weighs on both; still run it
+on a quiet machine, and alternate runs when comparing two versions.  Nothing here is
+asserted.
 """
 
 from __future__ import annotations
@@ -233,19 +235,29 @@ def _from_file(path: Path) -> Outline:
 # ------------------------------------------------------------------------ timing
 
 
-def _time(fn: Callable[[], object], calls: int) -> dict:
-    wall, cpu = [], []
-    for _ in range(calls):
-        w0, c0 = time.perf_counter(), time.process_time()
-        fn()
-        cpu.append(time.process_time() - c0)
-        wall.append(time.perf_counter() - w0)
+def _summary(wall: list, cpu: list) -> dict:
     return {
         "wall_med": statistics.median(wall),
         "wall_min": min(wall),
         "cpu_med": statistics.median(cpu),
         "cpu_min": min(cpu),
     }
+
+
+def _time_alternating(first: Callable[[], object], second: Callable[[], object], calls: int):
+    """Wall and CPU time of both (median and least), timed call by call in turns
+    (which one goes first alternates), so that a burst of load on the machine weighs
+    on both alike."""
+    wall: tuple[list, list] = ([], [])
+    cpu: tuple[list, list] = ([], [])
+    fns = (first, second)
+    for i in range(calls):
+        for k in (0, 1) if i % 2 == 0 else (1, 0):
+            w0, c0 = time.perf_counter(), time.process_time()
+            fns[k]()
+            cpu[k].append(time.process_time() - c0)
+            wall[k].append(time.perf_counter() - w0)
+    return _summary(wall[0], cpu[0]), _summary(wall[1], cpu[1])
 
 
 def _calls_for(seconds: float, budget: float, lo: int = 3, hi: int = OVERHEAD_CALLS) -> int:
@@ -322,7 +334,7 @@ def run_overhead(calls: int) -> None:
         f"fixed cost: {case.name}, {case.n_vertices} vertices, size {case.size:.4g}, "
         f"{len(mesh.triangles)} triangles (Triangle: {len(tri()['triangles'])})"
     )
-    ta, tt = _time(aft, calls), _time(tri, calls)
+    ta, tt = _time_alternating(aft, tri, calls)
     print(f"{'ms per call':<16}{'wall med':>9}{'wall min':>9}{'cpu med':>9}{'cpu min':>9}")
     for label, t in (("aftmesh", ta), ("Triangle pq30a", tt)):
         print(
@@ -375,7 +387,7 @@ def run_real(budget: float, breakdown: bool, folder: Path = REALWORLD) -> None:
         once = time.process_time() - t0
         n_tri = len(tri()["triangles"])
         calls = _calls_for(once, budget)
-        ta, tt = _time(aft, calls)["cpu_med"], _time(tri, calls)["cpu_med"]
+        ta, tt = (t["cpu_med"] for t in _time_alternating(aft, tri, calls))
         # the ratio per triangle made: aftmesh and Triangle make different counts
         # from the same boundary and size
         per_tri.append((ta / len(mesh.triangles)) / (tt / n_tri))
