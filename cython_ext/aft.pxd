@@ -47,16 +47,21 @@ cdef struct Aft:
     int64_t n_scaffold_planted
     int64_t n_scaffold_kept     # could not be removed: ordinary vertices of the mesh
     int32_t crowd_scaffold  # the scaffold vertex is_crowded found too near R
-    # converging rows' lattice (lattice.pxi): whether rows may snap to it, its origin
-    # and the direction of its rows, whether the last Compute_new_candidate moved R
-    # onto it and R before the move, and the front's curvature at each vertex
+    # converging rows' lattice (lattice.pxi): whether rows may snap to it, whether it
+    # is the lattice of a size field's plateau, its origin and the direction of its
+    # rows, whether the last Compute_new_candidate moved R onto it and R before the
+    # move, the front's curvature at each vertex (one constant size) and each vertex's
+    # row from the boundary (a plateau)
     bint lat_on
+    bint lat_plateau
     double lat_o[2]
     double lat_dir[2]
     bint lat_moved
     double lat_plain[2]
     double* vkappa
     int32_t vkappa_cap
+    int32_t* vrow
+    int32_t vrow_cap
     # Check_visible's output: crossed edges of the line of sight, and where R lies
     int32_t* left
     int32_t* right

@@ -87,6 +87,7 @@ cdef void aft_free(Aft* A) noexcept nogil:
     free(A.right)
     free(A.scaffold_alive)
     free(A.vkappa)
+    free(A.vrow)
     size_field_free(&A.size)
     memset(A, 0, sizeof(Aft))
 
@@ -358,7 +359,8 @@ cdef void compute_new_candidate(Aft* A, Tri* T, int e, double* R, double* h_out)
     first guess of R than at E's midpoint), by at most R_SIDE_MAX_GROWING |E|.
 
     Under one constant size, R of an edge in a row from a curved boundary may move
-    to the nearest point of one lattice (lattice.pxi).
+    to the nearest point of one lattice, and so may R of an edge in the rows well
+    inside a size field's plateau (lattice.pxi).
 
     h_out is the length New_is_preferred's proximity rules measure against: the local
     size, but at most PROXIMITY_PER_SIDE * d, and LATTICE_PROXIMITY times that where

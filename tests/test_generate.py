@@ -594,6 +594,11 @@ class SameGetNextEdge(Strategy):
         dc.triangle_sample("face"),
         # a disc at its edges' length: rows snap to the lattice (lattice.pxi)
         dc.shapely_case("disc", Point(0, 0).buffer(1.0, 16), 2.0 * np.sin(np.pi / 64)),
+        # a hole's short edges make the size a field with a plateau, whose inner rows
+        # snap to the lattice of the number (lattice.pxi)
+        dc.shapely_case(
+            "plateau", box(0, 0, 2, 1).difference(Point(0.5, 0.5).buffer(0.05, 4)), 0.06
+        ),
     ],
     ids=repr,
 )
@@ -861,6 +866,20 @@ def test_lattice_rows_follow_the_longest_straight_side(checked, turn):
     slot = affinity.rotate(LineString([(0, 0), (2, 0)]).buffer(0.5, 32), turn, origin=(0.1, 0.2))
     mesh = checked(aftmesh.generate(slot, 0.03), domain_area=slot.area)
     assert mesh.quality()["radius_ratio_mean"] > 0.9955
+
+
+@pytest.mark.parametrize("turn", [0.0, 17.0, 45.0])
+def test_rows_well_inside_a_plateau_give_way_to_one_lattice(checked, turn):
+    """A number size over a rectangle with two small polygonal holes: the holes' short
+    edges make the size a field graded up to the number, which then holds over the
+    inside (a plateau).  The fronts of the sides and of the holes met there in seams of
+    vertices of five and seven (mean radius ratio 0.9910-0.9914); with the rows four
+    or more from the boundary moving onto one lattice of the number (lattice.pxi),
+    0.9949-0.9950 at every turn."""
+    domain = box(0, 0, 2, 1).difference(Point(0.5, 0.5).buffer(0.05, 4))
+    domain = affinity.rotate(domain.difference(Point(1.4, 0.4).buffer(0.03, 3)), turn)
+    mesh = checked(aftmesh.generate(domain, 0.03), domain_area=domain.area)
+    assert mesh.quality()["radius_ratio_mean"] > 0.994
 
 
 @pytest.mark.parametrize(
