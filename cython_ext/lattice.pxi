@@ -46,26 +46,27 @@
 # the condition, poly-A, poly-face and poly-double_hex3 lost 0.001-0.007 of mean radius
 # ratio, and with it their meshes are unchanged.
 #
-# The same lattice serves the plateau of a size field that is not one constant: a
-# number size whose input has edges shorter than it, so that the cones (sizing.pxi)
-# grade the size up from those edges to the number, which then holds over the inside.
-# There the fronts of every stretch of an irregular boundary met in seams of vertices
-# of five and seven: inside rw-coast (four sizes or more from the boundary) the
-# triangles had a mean radius ratio of 0.985 and six triangles at 83 % of the
-# vertices, against Gmsh's 0.995 and 95-98 %.  So on a plateau R moves to the lattice
-# of the number when the size at E's middle and at R is the number and both ends of E
-# lie LATTICE_PLATEAU_ROWS rows or more from the boundary (a new vertex's row is one
-# more than its edge's nearer end; the boundary's vertices are row 0), whatever the
+# The same lattice serves the plateau of a size field that is not one constant: a number
+# size whose input has edges shorter than it, so that the cones (sizing.pxi) grade the
+# size up from those edges to the number, which then holds over the inside.  There the
+# fronts of every stretch of an irregular boundary met in seams of vertices of five and
+# seven: inside rw-coast (four sizes or more from the input edges) the triangles had a
+# mean radius ratio of 0.985-0.986 and six triangles at 83-84 % of their vertices,
+# against Gmsh's 0.994-0.996 and 96-98 % (now 0.9986-1.0000 and 98-100 %; `python -m
+# benchmarks.quality rw-coast --bands`).  So on a plateau R moves to the lattice of the
+# number when the size at E's middle and at R is the number and both ends of E lie
+# LATTICE_PLATEAU_ROWS rows or more from the boundary (a new vertex's row is one more
+# than its edge's nearer end; the boundary's vertices are row 0), whatever the
 # boundary's curvature: the rows graded up from a short edge have forgotten its
-# direction by then, and channels narrower than about twice that many rows never
-# snap, so their rows keep following their walls.  On the real-world group of the
-# benchmarks the mean radius ratio went from 0.9669 to 0.9674 (rw-coast 0.9754 ->
-# 0.9789, rw-poly2tri-funny 0.9766 -> 0.9799, rw-airfoil 0.9953 -> 0.9977, rw-city
-# 0.9863 -> 0.9860 the largest loss), on 46 random stars, fractal coastlines and
-# holed coastlines from 0.97199 to 0.97362 (39 better, 4 worse by at most 0.0001), and
-# on a 2 x 1 rectangle with two small polygonal holes turned by 0, 17 and 45 degrees
-# from 0.9913 / 0.9910 / 0.9914 to 0.9950 / 0.9950 / 0.9949.  Meshes under one
-# constant size, and under a size callable, are unchanged.
+# direction by then, and channels narrower than about twice that many rows never snap,
+# so their rows keep following their walls.  On the real-world group of the benchmarks
+# the mean radius ratio went from 0.9669 to 0.9674 (rw-coast 0.9754 -> 0.9789,
+# rw-poly2tri-funny 0.9766 -> 0.9799, rw-airfoil 0.9953 -> 0.9977, rw-city 0.9863 ->
+# 0.9860 the largest loss), on 46 random stars, fractal coastlines and holed coastlines
+# from 0.97199 to 0.97362 (39 better, 4 worse by at most 0.0001), and on a 2 x 1
+# rectangle with two small polygonal holes turned by 0, 17 and 45 degrees from 0.9913 /
+# 0.9910 / 0.9914 to 0.9950 / 0.9950 / 0.9949.  Meshes under one constant size, and
+# under a size callable, are unchanged.
 #
 # Uses: halfedge.pxd; aft.pxd (Aft: vkappa, vrow, lat_on, lat_plateau, lat_o,
 # lat_dir, lat_moved, lat_plain, and the size field); triangulation.pxi (_grow).
