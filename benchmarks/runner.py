@@ -250,10 +250,16 @@ def _later_passes(cname, rows: list[dict], counts: list[int], quick, log) -> Non
             row["wall"] = row.get("wall", 0.0) + res["wall"]
 
 
+def median_timing(timings: list) -> dict | None:
+    """Per stage, the median of the runs' internal timings (the workers'
+    ``internal_timings``; None unless every run has them)."""
+    if not timings or not all(timings):
+        return None
+    return {k: statistics.median(t[k] for t in timings) for k in timings[0]}
+
+
 def _finish_rows(cname: str, rows: list[dict], log) -> None:
     """Medians, triangle counts and the ratios to the reference mesher."""
-    from .worker import median_timing
-
     for row in rows:
         if "times" not in row:
             continue

@@ -111,7 +111,6 @@ def mesh_job(job: dict) -> dict:
         "stats": stats,
         "passes": passes,
         "internal_timings": timings,
-        "internal_timing": median_timing(timings),
     }
     if own is not None:
         result["own_cdt"] = own
@@ -138,14 +137,6 @@ def own_cdt_times(points: np.ndarray, segments: np.ndarray, repeat: int) -> dict
         times.append(time.perf_counter() - t0)
         cpu.append(time.process_time() - c0)
     return {"times": times, "cpu": cpu}
-
-
-def median_timing(timings: list) -> dict | None:
-    """Per stage, the median of the runs' internal timings (None unless every run
-    has them)."""
-    if not timings or not all(timings):
-        return None
-    return {k: float(np.median([t[k] for t in timings])) for k in timings[0]}
 
 
 def _internal_timing(raw):
