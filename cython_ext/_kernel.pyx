@@ -828,18 +828,26 @@ cdef class Triangulation:
         _raise_for(&self.T, res)
         return res
 
-    def refine(self, double min_angle, int n_corners, bint split_segments=True):
+    def refine(self, double min_angle, int n_corners, bint split_segments=True,
+               int smooth_rounds=0, int first_movable=-1, bint slide=True):
         """The minimum-angle pass (refine.pxi): Delaunay refinement of the meshed
         triangles with an angle below `min_angle` degrees.  Vertices below `n_corners`
-        are input vertices (ends of input segments).  Respects max_triangles of
-        set_options.  Returns a dict of counts."""
+        are input vertices (ends of input segments).  With smooth_rounds > 0 (the
+        smoothing rounds asked for), the vertices around the ones it added settle by
+        a few smoothing rounds (Basic_aft's, first_movable on, and the pass's interior
+        ones move; with `slide`, the points inside a chain slide) and the pass runs
+        again (refine.pxi's refine_settled).  Respects max_triangles of set_options.
+        Returns a dict of counts (of both runs)."""
         cdef Refine R
         cdef int res
+        if smooth_rounds > 0 and not 0 <= first_movable <= self.T.nv:
+            raise ValueError(f"first_movable must be in 0..{self.T.nv}, got {first_movable}")
         _refine_setup(&R, min_angle, n_corners, split_segments)
         self._note_thread()
         try:
             with nogil:
-                res = refine_mesh(&R, &self.A, &self.T)
+                res = refine_settled(&R, &self.A, &self.T, first_movable, slide,
+                                     smooth_rounds)
         finally:
             refine_free(&R)
         _reraise_pending(&self.A)

@@ -240,7 +240,7 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
         P.moves = P.res
     P.t_aft = _clock()
     if P.res >= 0 and P.refining:
-        P.res = refine_mesh(R, A, T)
+        P.res = refine_settled(R, A, T, P.first_movable, P.n_corner >= 0, P.smooth_rounds)
     return PIECES_RAN
 
 

@@ -13,6 +13,10 @@
 # first round: the second round then moves the vertices without swaps, the Delaunay
 # property is restored from every triangle that changed, and the rounds go on.
 #
+# settle_refined runs the same rounds once more after the minimum-angle pass
+# (refine.pxi's refine_settled), only around the points the pass added and without
+# valence flips; the pass's own splits slide there too (they are inside chains).
+#
 # Uses: halfedge.pxd (Tri.vdirty, which triangulation.pxi's legalize_meshed sets);
 # aft.pxd (Aft); front.pxi (check_signals); optimize.pxi (_optimize_vertex);
 # sliding.pxi (slide_vertex); chains.pxi (chain_ends); valence.pxi (valence_flips);
@@ -35,6 +39,7 @@ cdef struct Movable:
     int first_sliding   # from here to first_movable: split points, which slide
     int first_movable   # from here on: Basic_aft's vertices, which move freely
     int32_t* vend       # the ends of each split point's chain (chains.pxi); NULL: none
+    const uint8_t* only  # NULL, or the only vertices that may be judged
 
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
@@ -67,6 +72,7 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes, bint valence=True
     M.first_movable = first_movable
     M.first_sliding = n_corner if 0 <= n_corner < first_movable else first_movable
     M.vend = NULL
+    M.only = NULL
     if M.first_sliding < first_movable:
         M.vend = <int32_t*> malloc(2 * T.nv * sizeof(int32_t))
         res = ERR_NOMEM if M.vend == NULL else chain_ends(T, M.first_sliding, M.vend)
@@ -134,13 +140,13 @@ cdef int _smooth_rounds(Aft* A, Tri* T, const Movable* M, int passes, uint8_t* t
     for p in range(passes):
         moved_now = 0
         for v in range(M.first_sliding, T.nv):
-            if not T.vdirty[v]:
+            if not T.vdirty[v] or (M.only != NULL and not M.only[v]):
                 continue
             T.vdirty[v] = 0
-            if v >= M.first_movable:
-                res = _optimize_vertex(T, v, swaps)
-            elif M.vend[2 * v] >= 0:
+            if M.vend != NULL and M.vend[2 * v] >= 0:
                 res = slide_vertex(T, v, M.vend[2 * v], M.vend[2 * v + 1], swaps)
+            elif v >= M.first_movable:
+                res = _optimize_vertex(T, v, swaps)
             else:
                 continue
             if res < 0:
@@ -172,3 +178,31 @@ cdef void _mark_ring(Tri* T, int v) noexcept nogil:
         e = T.twin[prv(e)]
         if e == e0 or e < 0:
             return
+
+
+cdef int settle_refined(Aft* A, Tri* T, int first_new, int first_movable,
+                        int32_t* vend, int rounds) noexcept nogil:
+    """Smoothing rounds over the vertices the minimum-angle pass added (first_new on)
+    and their neighbours, without valence flips: Basic_aft's vertices
+    (first_movable on) and the pass's interior ones move (optimize.pxi), the points
+    inside a chain slide along it (sliding.pxi) when vend (the pass's chain ends, 2
+    per vertex) is not NULL.  Returns the number of moves, or an error."""
+    cdef int res, v
+    cdef Movable M
+    cdef uint8_t* dirty
+    if rounds <= 0 or first_new >= T.nv:
+        return 0
+    dirty = <uint8_t*> calloc(T.nv, 1)
+    if dirty == NULL:
+        return ERR_NOMEM
+    M.first_movable = first_movable
+    M.first_sliding = 0 if vend != NULL else first_movable
+    M.vend = vend
+    M.only = NULL
+    T.vdirty = dirty
+    for v in range(first_new, T.nv):
+        _mark_ring(T, v)
+    res = _smooth_rounds(A, T, &M, rounds, NULL, True)
+    T.vdirty = NULL
+    free(dirty)
+    return res

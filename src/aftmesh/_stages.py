@@ -284,13 +284,22 @@ def smooth(kernel, boundary: Boundary, dom: Domain, opts: Options) -> int:
     return kernel.smooth(len(boundary.vertices), opts.smooth, n_corners=n_corners)
 
 
-def refine(kernel, dom: Domain, opts: Options) -> dict | None:
+def refine(kernel, boundary: Boundary, dom: Domain, opts: Options) -> dict | None:
     """The minimum-angle pass after smoothing (none with greedy, without swaps, or with
     min_angle off); what it did, for info["min_angle"].  With split_boundary=False it
-    splits no input edge and inserts only points whose triangles all meet the bound."""
+    splits no input edge and inserts only points whose triangles all meet the bound.
+    With smoothing on, the vertices around its new ones settle and the pass runs
+    again (refine.pxi's refine_settled)."""
     if not opts.min_angle or opts.greedy or not opts.swaps:
         return None
-    done = kernel.refine(opts.min_angle, len(dom.vertices), split_segments=opts.split_boundary)
+    done = kernel.refine(
+        opts.min_angle,
+        len(dom.vertices),
+        split_segments=opts.split_boundary,
+        smooth_rounds=opts.smooth,
+        first_movable=len(boundary.vertices),
+        slide=opts.slides,
+    )
     return {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
 
 

@@ -202,9 +202,10 @@ def generate(
         again.  Input vertices never move.
         ``info['smoothing_moves']`` counts the moves.
     slide_boundary : bool
-        Let smoothing slide the points that split an input edge along it (default).
-        False keeps them where the boundary's discretization put them, whatever the
-        interior's mesh (the minimum-angle pass may still split a piece).  Never with
+        Let smoothing slide the points that split an input edge along it (default):
+        the discretization's, and the minimum-angle pass's where the mesh settles
+        after it.  False keeps them where they were put, whatever the interior's mesh
+        (the minimum-angle pass may still split a piece).  Never with
         ``greedy`` (its mesh is the CDT of the discretized boundary), and a run in
         more than one part never slides them, since its parts share them.
     strategy : Strategy, optional
@@ -241,9 +242,12 @@ def generate(
         smoothing, a last pass refines every triangle with a smaller angle by Delaunay
         refinement (off-centres, and splits of the segments they encroach, at dyadic
         distances from an apex where segments meet below 60 degrees), keeping the mesh
-        the CDT of its vertices and the input edges.  Then no triangle has an angle
-        below the bound, except triangles forced by an input angle below it (their
-        shortest edge joins two input segments that meet at such an angle).  The pass
+        the CDT of its vertices and the input edges.  With smoothing on, the vertices
+        around the points it added then get two smoothing rounds (its splits sliding
+        along their segments, see ``slide_boundary``) and the pass runs again.  Then no
+        triangle has an angle below the bound, except triangles forced by an input angle
+        below it (their shortest edge joins two input segments that meet at such an
+        angle).  The pass
         is proven to terminate up to about 26.5 degrees and does so in practice up to
         about 33.8, so values above 34 are refused; it is also capped (max_triangles
         wins over the bound; a last-resort cap of 8 insertions per triangle).  With
@@ -253,7 +257,7 @@ def generate(
         not run.  ``info['min_angle']`` says what it did: ``bound``, ``reached`` (no
         triangle below the bound but the excepted ones), ``excepted_triangles``,
         ``unresolved_triangles``, ``inserted`` (of which ``segment_splits`` on
-        segments), ``stopped_by`` (None, 'max_triangles' or 'insertion_cap') and
+        segments; both runs together), ``stopped_by`` (None, 'max_triangles' or 'insertion_cap') and
         ``insertion_cap``; None when the pass is off.
     scaffold : bool
         Plant a sparse lattice of temporary points (8 sizes apart, kept 4 sizes from
@@ -332,7 +336,7 @@ def generate(
     _stages.run_front(kernel, opts, boundary.triangle_hint)
     moves = _stages.smooth(kernel, boundary, dom, opts)
     t_aft = time.perf_counter()
-    refined = _stages.refine(kernel, dom, opts)
+    refined = _stages.refine(kernel, boundary, dom, opts)
     t_refine = time.perf_counter()
     timing = _stages.timing(t_start, t_boundary, t_cdt, t_aft, t_refine)
     mesh = _stages.assemble(
