@@ -35,11 +35,11 @@ cdef enum:
 
 
 cdef struct Movable:
-    # which vertices smoothing may move
-    int first_sliding   # from here to first_movable: split points, which slide
-    int first_movable   # from here on: Basic_aft's vertices, which move freely
-    int32_t* vend       # the ends of each split point's chain (chains.pxi); NULL: none
-    const uint8_t* only  # NULL, or the only vertices that may be judged
+    # which vertices smoothing may move: from first_sliding on, a vertex inside a chain
+    # slides along it, and the others from first_movable on move freely
+    int first_sliding   # the first vertex that may slide
+    int first_movable   # Basic_aft's vertices (and the minimum-angle pass's) from here
+    int32_t* vend       # the ends of each point's chain (chains.pxi); NULL: none slide
 
 
 cdef inline double _shape(const double* a, const double* b, const double* c) noexcept nogil:
@@ -72,7 +72,6 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes, bint valence=True
     M.first_movable = first_movable
     M.first_sliding = n_corner if 0 <= n_corner < first_movable else first_movable
     M.vend = NULL
-    M.only = NULL
     if M.first_sliding < first_movable:
         M.vend = <int32_t*> malloc(2 * T.nv * sizeof(int32_t))
         res = ERR_NOMEM if M.vend == NULL else chain_ends(T, M.first_sliding, M.vend)
@@ -140,7 +139,7 @@ cdef int _smooth_rounds(Aft* A, Tri* T, const Movable* M, int passes, uint8_t* t
     for p in range(passes):
         moved_now = 0
         for v in range(M.first_sliding, T.nv):
-            if not T.vdirty[v] or (M.only != NULL and not M.only[v]):
+            if not T.vdirty[v]:
                 continue
             T.vdirty[v] = 0
             if M.vend != NULL and M.vend[2 * v] >= 0:
@@ -198,7 +197,6 @@ cdef int settle_refined(Aft* A, Tri* T, int first_new, int first_movable,
     M.first_movable = first_movable
     M.first_sliding = 0 if vend != NULL else first_movable
     M.vend = vend
-    M.only = NULL
     T.vdirty = dirty
     for v in range(first_new, T.nv):
         _mark_ring(T, v)

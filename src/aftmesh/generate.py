@@ -244,21 +244,21 @@ def generate(
         distances from an apex where segments meet below 60 degrees), keeping the mesh
         the CDT of its vertices and the input edges.  With smoothing on, the vertices
         around the points it added then get two smoothing rounds (its splits sliding
-        along their segments, see ``slide_boundary``) and the pass runs again.  Then no
-        triangle has an angle below the bound, except triangles forced by an input angle
-        below it (their shortest edge joins two input segments that meet at such an
-        angle).  The pass
-        is proven to terminate up to about 26.5 degrees and does so in practice up to
-        about 33.8, so values above 34 are refused; it is also capped (max_triangles
-        wins over the bound; a last-resort cap of 8 insertions per triangle).  With
-        ``split_boundary=False`` it splits no input edge and inserts a point only where
-        all the triangles it makes meet the bound (the mesh never gets worse; the
-        bound may then stay out of reach); with ``greedy`` or ``swaps=False`` it does
-        not run.  ``info['min_angle']`` says what it did: ``bound``, ``reached`` (no
-        triangle below the bound but the excepted ones), ``excepted_triangles``,
-        ``unresolved_triangles``, ``inserted`` (of which ``segment_splits`` on
-        segments; both runs together), ``stopped_by`` (None, 'max_triangles' or 'insertion_cap') and
-        ``insertion_cap``; None when the pass is off.
+        along their segments, see ``slide_boundary``) and the pass runs again.  Then
+        no triangle has an angle below the bound, except triangles forced by an input
+        angle below it (their shortest edge joins two input segments that meet at such
+        an angle).  The pass is proven to terminate up to about 26.5 degrees and does
+        so in practice up to about 33.8, so values above 34 are refused; it is also
+        capped (max_triangles wins over the bound; a last-resort cap of 8 insertions
+        per triangle).  With ``split_boundary=False`` it splits no input edge and
+        inserts a point only where all the triangles it makes meet the bound (the mesh
+        never gets worse; the bound may then stay out of reach); with ``greedy`` or
+        ``swaps=False`` it does not run.  ``info['min_angle']`` says what it did:
+        ``bound``, ``reached`` (no triangle below the bound but the excepted ones),
+        ``excepted_triangles``, ``unresolved_triangles``, ``inserted`` (of which
+        ``segment_splits`` on segments; both runs together), ``stopped_by`` (None,
+        'max_triangles' or 'insertion_cap') and ``insertion_cap``; None when the pass
+        is off.
     scaffold : bool
         Plant a sparse lattice of temporary points (8 sizes apart, kept 4 sizes from
         the boundary) in the unmeshed region before the front starts, and remove each
