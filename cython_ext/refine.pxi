@@ -105,7 +105,6 @@ cdef struct Refine:
     int stop
     int32_t* vend           # 2 per vertex: the ends of the chain it is inside, or -1
     int vend_cap
-    bint chains_ready       # vend holds every vertex's chain
     int32_t* tq             # FIFO of (t, a, b, c)
     int64_t tq_head, tq_n, tq_cap
     int32_t* sq             # stack of segments (u, w) to split
@@ -301,10 +300,10 @@ cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
 
 cdef int _chain_init(Refine* R, Tri* T) noexcept nogil:
     """R.vend for every vertex of T (chains.pxi's chain_ends); the pass keeps it for
-    the points it adds, and moves along a chain keep it too."""
+    the points it adds, and moves along a chain keep it too, so a second run of the
+    pass on the same R finds it set (vend is NULL until this first runs)."""
     if _vend_reserve(R, T.nv):
         return ERR_NOMEM
-    R.chains_ready = True
     return chain_ends(T, R.n_corner, R.vend)
 
 
@@ -969,7 +968,7 @@ cdef int refine_mesh(Refine* R, Aft* A, Tri* T) noexcept nogil:
         return res                  # nothing is bad: the counts stay 0
     R.tiny = _tiny_length(T)
     R.max_insert = max(REFINE_CAP_MIN, REFINE_CAP_PER_TRIANGLE * R.n_meshed)
-    if not R.chains_ready:
+    if R.vend == NULL:
         res = _chain_init(R, T)
         if res < 0:
             return res
