@@ -861,7 +861,8 @@ cdef class Triangulation:
     def counters(self):
         return dict(meshed=self.A.n_meshed, unmeshed=self.A.n_unmeshed,
                     new_vertices=self.A.n_new, steps=self.A.n_steps,
-                    forced_edges=self.A.n_forced, scaffold=self.A.n_scaffold_planted,
+                    forced_edges=self.A.n_forced, valence_splits=self.A.n_split,
+                    scaffold=self.A.n_scaffold_planted,
                     scaffold_kept=self.A.n_scaffold_kept)
 
     def _check_edge(self, int e):

@@ -38,6 +38,7 @@ cdef struct Aft:
     int64_t n_new           # vertices created by Update_internal
     int64_t n_steps         # passes through the while loop
     int64_t n_forced        # Update_internal calls that needed Cline-Renka for F, G
+    int64_t n_split         # points smoothing's valence splits added (valence.pxi)
     # scaffold vertices (scaffold.pxi): vertices scaffold_lo..scaffold_hi of the
     # unmeshed CDT, scaffold_alive[v - scaffold_lo] while v is one (n_scaffold of them)
     bint scaffold_on        # plant them (set_options decides)

@@ -21,12 +21,14 @@
 # vertices do not support are undone there; the rest stay, and the final mesh is the
 # CDT of its vertices and the input edges as before.
 #
-# Uses: halfedge.pxd; predicates.pxi (orient2d); triangulation.pxi (flip);
+# Uses: halfedge.pxd; aft.pxd (Aft: the triangle cap and counts); predicates.pxi
+# (orient2d); triangulation.pxi (flip, locate, add_vertex, insert_vertex_at);
 # smoothing.pxi (_shape).
 from halfedge cimport *
+from aft cimport Aft
 from libc.math cimport atan2, fabs, floor
 from libc.stdlib cimport calloc, free
-from libc.stdint cimport uint8_t
+from libc.stdint cimport uint8_t, int32_t
 
 # A flip that would make a triangle flatter than this (_shape: 1 equilateral; 0.6 is
 # an isosceles triangle of about 22 degrees) is not made: the settling round does not
@@ -119,3 +121,131 @@ cdef int valence_flips(Tri* T, int first_movable, uint8_t* touched) noexcept nog
         flips += 1
     free(x)
     return flips
+
+
+# ------------------------------------------------------------------ splits
+#
+# A vertex Basic_aft made that is in eight triangles or more, among vertices of six,
+# is one no flip helps: a flip takes a triangle from it and from one neighbour and
+# gives one to two others, so the excesses only move (the sum above does not fall).
+# Its triangles are the flattest of the interior (mean radius ratio 0.925 on rw-gear,
+# whose whole mesh has 0.984).  valence_splits puts a new point SPLIT_AT of the
+# way along its longest edge: the Delaunay flips of the insertion give the new point
+# some of its triangles, and the smoothing rounds that follow share the ring out
+# between the two.  The point is inserted like any other (insert_vertex_at: Lawson
+# flips), so the mesh stays the CDT of its vertices and the input edges; each vertex
+# is looked at once a call, so the splits end; each adds two triangles, and none is
+# made that would take the mesh past max_triangles.
+
+# the fewest triangles at a vertex Basic_aft made for valence_splits to split it
+cdef int SPLIT_VALENCE = 8
+# where the new point goes along the longest edge: nearer the vertex it relieves than
+# the middle, so the far end keeps its ring (splitting after the last round only,
+# 0.2, 0.25 and 0.3 gave the benchmarks' real-world group the same mean radius ratio;
+# 0.5 left rw-gear's 0.0003 lower)
+cdef double SPLIT_AT = 0.25
+# the splits before the first round leave a vertex to the valence flips when one of
+# its neighbours that Basic_aft made is in this many triangles or fewer: a flip then
+# gives that neighbour one of its triangles and helps both, where a split first left
+# the neighbour at four (a radius ratio of 0.71 at a straight side, in
+# test_rows_from_a_small_hole_meet_the_first_row_of_a_straight_side).  At five (in
+# both passes) the splits lost most of their gain: most vertices of eight have a
+# neighbour of five.
+cdef int SPLIT_DEFICIENT = 4
+
+
+cdef int _valence_split_point(Tri* T, int v, double* p) noexcept nogil:
+    """The point to split v at (see above), in p; the triangle to locate it from, or
+    -1 when v has no unconstrained edge or is not surrounded by meshed triangles."""
+    cdef int e0 = T.vhe[v], e = e0, u, t = -1, guard = 0
+    cdef double best = -1.0, d2
+    cdef double* pv = P(T, v)
+    cdef double* pu
+    if e0 < 0:
+        return -1
+    while True:
+        u = T.tv[nxt(e)]
+        if u < 0 or T.tstate[e // 3] != T_MESHED or guard > T.nt:
+            return -1
+        pu = P(T, u)
+        d2 = (pu[0] - pv[0]) * (pu[0] - pv[0]) + (pu[1] - pv[1]) * (pu[1] - pv[1])
+        if d2 > best and not (T.eflag[e] & (E_SEGMENT | E_FIXED)):
+            best = d2
+            t = e // 3
+            p[0] = pv[0] + SPLIT_AT * (pu[0] - pv[0])
+            p[1] = pv[1] + SPLIT_AT * (pu[1] - pv[1])
+        guard += 1
+        e = T.twin[prv(e)]
+        if e == e0:
+            return t
+
+
+cdef bint _meshed_in(Tri* T, int loc, int where, int32_t region) noexcept nogil:
+    # the place locate() found is inside meshed triangles of the region, off segments
+    if loc == LOC_IN_TRIANGLE:
+        return T.tstate[where] == T_MESHED and T.tregion[where] == region
+    if loc != LOC_ON_EDGE or T.eflag[where] & (E_SEGMENT | E_FIXED):
+        return False
+    return (T.tstate[where // 3] == T_MESHED and T.tregion[where // 3] == region
+            and T.tstate[T.twin[where] // 3] == T_MESHED)
+
+
+cdef bint _next_to_deficient(Tri* T, int v, int first_movable, int nv0,
+                             const int* n) noexcept nogil:
+    # a neighbour of v in first_movable..nv0 - 1 (n counts their triangles; the points
+    # this pass has added are not counted) is in SPLIT_DEFICIENT triangles or fewer
+    cdef int e0 = T.vhe[v], e = e0, u, guard = 0
+    while e0 >= 0 and guard <= T.nt:
+        u = T.tv[nxt(e)]
+        if first_movable <= u < nv0 and n[u] <= SPLIT_DEFICIENT:
+            return True
+        guard += 1
+        e = T.twin[prv(e)]
+        if e == e0:
+            break
+    return False
+
+
+cdef int valence_splits(Aft* A, Tri* T, int first_movable, bint early) noexcept nogil:
+    """Split each vertex from first_movable on that is in SPLIT_VALENCE meshed
+    triangles or more (counted before the first split; see above), except, when
+    `early` (before the valence flips), one next to a vertex of SPLIT_DEFICIENT or
+    fewer.  The new triangles count in A.n_meshed and the new points in A.n_split.
+    Returns the number of points inserted (they are the last vertices), or an
+    error."""
+    cdef int v, t, loc, where, w, res = 0, nv0 = T.nv, count = 0
+    cdef double p[2]
+    cdef int* n = <int*> calloc(nv0 if nv0 > 0 else 1, sizeof(int))
+    if n == NULL:
+        return ERR_NOMEM
+    for t in range(T.nt):
+        if T.tstate[t] == T_MESHED:
+            n[T.tv[3 * t]] += 1
+            n[T.tv[3 * t + 1]] += 1
+            n[T.tv[3 * t + 2]] += 1
+    for v in range(first_movable, nv0):
+        if n[v] < SPLIT_VALENCE:
+            continue
+        if A.max_triangles >= 0 and A.n_meshed + 2 > A.max_triangles:
+            break
+        if early and _next_to_deficient(T, v, first_movable, nv0, n):
+            continue
+        t = _valence_split_point(T, v, p)
+        if t < 0:
+            continue
+        where = NONE
+        loc = locate(T, p, t, &where)
+        if loc < 0:
+            res = loc
+            break
+        if not _meshed_in(T, loc, where, T.tregion[t]):
+            continue
+        w = add_vertex(T, p[0], p[1])
+        res = w if w < 0 else insert_vertex_at(T, w, loc, where)
+        if res < 0:
+            break
+        A.n_meshed += 2
+        A.n_split += 1
+        count += 1
+    free(n)
+    return res if res < 0 else count

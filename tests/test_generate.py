@@ -170,10 +170,12 @@ def assert_valid(mesh, case=None, *, split_boundary=True, delaunay=True, area=No
     rows = assert_count_formula(mesh, EXPECTED_M.get(case.name) if case is not None else None)
     if case is not None and not isinstance(case.domain, dict):
         # no input vertex inside these domains: the interior vertices are exactly the
-        # ones Basic_aft created (Update_internal), each strictly inside, and the
-        # interior ones of the minimum-angle pass
+        # ones Basic_aft created (Update_internal), each strictly inside, the points
+        # smoothing's valence splits added, and the interior ones of the minimum-angle
+        # pass
         refined = mesh.info["min_angle"]["interior"] if mesh.info["min_angle"] else 0
-        assert sum(r[2] for r in rows) == mesh.info["new_vertices"] + refined
+        made = mesh.info["new_vertices"] + mesh.info["valence_splits"]
+        assert sum(r[2] for r in rows) == made + refined
     if delaunay:
         dc.assert_cdt(mesh)
     return mesh
@@ -355,8 +357,10 @@ def test_max_triangles(case):
         assert_valid(mesh, case)
         assert len(mesh.triangles) <= n_max
         # formula (6) with the boundary fixed: each new vertex adds two triangles
-        assert len(mesh.triangles) == g + 2 * mesh.info["new_vertices"]
-        assert len(mesh.points) == len(greedy.points) + mesh.info["new_vertices"]
+        # (Basic_aft's, and smoothing's valence splits)
+        made = mesh.info["new_vertices"] + mesh.info["valence_splits"]
+        assert len(mesh.triangles) == g + 2 * made
+        assert len(mesh.points) == len(greedy.points) + made
     with pytest.raises(aftmesh.InvalidSizeError):
         aftmesh.generate(case.domain, case.size, max_triangles=g - 1)
 

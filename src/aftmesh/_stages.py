@@ -355,6 +355,8 @@ def assemble(
         # Update_internal calls where T(E, R) was not already a CDT triangle after
         # inserting R, so F and G were inserted by retriangulation (Lemma 3.1 says 0)
         "forced_edges": counters["forced_edges"],
+        # points smoothing inserted beside vertices of eight triangles or more
+        "valence_splits": counters["valence_splits"],
         # temporary vertices planted in the unmeshed region, and those that could not
         # be removed again (ordinary vertices of the mesh)
         "scaffold": counters["scaffold"],

@@ -199,8 +199,12 @@ def generate(
         first round towards six triangles at every vertex (where fronts met,
         smoothing alone leaves vertices of five and seven), the second round lets
         the vertices settle without swaps, and the swaps then make the mesh a CDT
-        again.  Input vertices never move.
-        ``info['smoothing_moves']`` counts the moves.
+        again; a vertex still in eight triangles or more, which no flip helps, gets
+        a new point a quarter of the way along its longest edge (before the first
+        round, and after the last followed by rounds from the new points), each
+        adding two triangles within ``max_triangles``.  Input vertices never move.
+        ``info['smoothing_moves']`` counts the moves, ``info['valence_splits']``
+        the points added.
     slide_boundary : bool
         Let smoothing slide the points that split an input edge along it (default):
         the discretization's, and the minimum-angle pass's where the mesh settles
