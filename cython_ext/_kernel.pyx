@@ -817,9 +817,11 @@ cdef class Triangulation:
     def smooth(self, int first_movable, int passes, bint valence=True, int n_corners=-1):
         """Smooth the vertices first_movable.. (those Basic_aft created) for `passes`
         rounds, each followed by Delaunay flips, with the valence flips after the
-        first (smoothing.pxi; valence=False: none); the points n_corners..first_movable
+        first and the valence splits before the first and after the last
+        (smoothing.pxi; valence=False: neither); the points n_corners..first_movable
         that split an input segment slide along it (-1: none do; n_corners is the
-        number of input vertices).  Returns the number of moves."""
+        number of input vertices).  The splits' points are new vertices (counters()'s
+        valence_splits).  Returns the number of moves."""
         cdef int res
         self._note_thread()
         with nogil:

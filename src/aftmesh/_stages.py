@@ -277,7 +277,8 @@ def smooth(kernel, boundary: Boundary, dom: Domain, opts: Options) -> int:
     """Smoothing rounds after the front has closed; the number of vertex moves.  The
     input vertices (numbered first) never move; the points that split an input edge
     (numbered next, up to the discretized boundary's end) slide along it with
-    slide_boundary, else stay."""
+    slide_boundary, else stay.  From 3 rounds on the valence splits may add vertices
+    after Basic_aft's (kernel.counters()["valence_splits"])."""
     if not opts.smooth:
         return 0
     n_corners = len(dom.vertices) if opts.slides else -1
