@@ -113,8 +113,8 @@ cdef int smooth(Aft* A, Tri* T, int first_movable, int passes, bint valence=True
 
 cdef int _split_and_settle(Aft* A, Tri* T, Movable* M) noexcept nogil:
     """The valence splits after the last round, then SPLIT_SETTLE_ROUNDS rounds from
-    the new points (M.vend, when set, grows to cover them: none of them slides).
-    Returns the number of moves, or an error."""
+    the new points (settle_refined; M.vend, when set, grows to cover them: none of
+    them slides).  Returns the number of moves, or an error."""
     cdef int nv0 = T.nv, v, res
     cdef int32_t* grown
     res = valence_splits(A, T, M.first_movable, False)
@@ -127,15 +127,7 @@ cdef int _split_and_settle(Aft* A, Tri* T, Movable* M) noexcept nogil:
         M.vend = grown
         for v in range(2 * nv0, 2 * T.nv):
             M.vend[v] = -1
-    T.vdirty = <uint8_t*> calloc(T.nv, 1)
-    if T.vdirty == NULL:
-        return ERR_NOMEM
-    for v in range(nv0, T.nv):
-        _mark_ring(T, v)
-    res = _smooth_rounds(A, T, M, SPLIT_SETTLE_ROUNDS, NULL, True)
-    free(T.vdirty)
-    T.vdirty = NULL
-    return res
+    return settle_refined(A, T, nv0, M.first_movable, M.vend, SPLIT_SETTLE_ROUNDS)
 
 
 cdef int _smooth_with_valence(Aft* A, Tri* T, const Movable* M, int passes) noexcept nogil:
@@ -228,11 +220,12 @@ cdef void _mark_ring(Tri* T, int v) noexcept nogil:
 
 cdef int settle_refined(Aft* A, Tri* T, int first_new, int first_movable,
                         int32_t* vend, int rounds) noexcept nogil:
-    """Smoothing rounds over the vertices the minimum-angle pass added (first_new on)
-    and their neighbours, without valence flips: Basic_aft's vertices
-    (first_movable on) and the pass's interior ones move (optimize.pxi), the points
-    inside a chain slide along it (sliding.pxi) when vend (the pass's chain ends, 2
-    per vertex) is not NULL.  Returns the number of moves, or an error."""
+    """Smoothing rounds over the vertices added from first_new on (by the
+    minimum-angle pass, or the last valence splits) and their neighbours, without
+    valence flips: Basic_aft's vertices (first_movable on) and the added interior ones
+    move (optimize.pxi), the points inside a chain slide along it (sliding.pxi) when
+    vend (chain ends, 2 per vertex) is not NULL.  Returns the number of moves, or an
+    error."""
     cdef int res, v
     cdef Movable M
     cdef uint8_t* dirty
