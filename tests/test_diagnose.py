@@ -49,3 +49,17 @@ def test_diagnosis_of_a_domain_wide_enough_for_the_scaffold(checked):
     checked(d.mesh)
     assert d.mesh.info["scaffold"] == 0
     assert sum(d.counts.values()) == len(d.bad) > 0
+
+
+def test_diagnosis_of_a_mesh_with_valence_splits(checked):
+    """Smoothing's valence splits add points after all the others: the diagnosis still
+    pairs the two meshes' vertices (it refused such meshes before)."""
+    plate = box(0.0, 0.0, 2.0, 1.0)
+    for x, y, r in ((0.45, 0.5, 0.22), (1.2, 0.3, 0.08), (1.55, 0.7, 0.15), (1.0, 0.8, 0.05)):
+        plate = plate.difference(Point(x, y).buffer(r, 24))
+    d = diagnose(plate, 0.03, threshold=0.9)
+    checked(d.mesh)
+    assert d.mesh.info["valence_splits"] > 0
+    rr = triangle_quality(d.mesh.points, d.mesh.triangles)["radius_ratio"]
+    assert np.array_equal(d.bad, np.flatnonzero(rr < 0.9))
+    assert sum(d.counts.values()) == len(d.bad) > 0

@@ -23,8 +23,10 @@ final mesh whose radius ratio is below a threshold with the first class that app
 ``other``
     none of these.
 
-It needs the same vertex numbering in both meshes: smoothing moves vertices but
-neither adds nor removes any, and the Python loop gives the compiled loop's mesh.  So it
+It needs the same vertex numbering in both meshes: smoothing moves vertices and adds
+only the valence splits' points, numbered after all the others (``info
+["valence_splits"]`` of them: no triangle was bad around them before smoothing), and
+the Python loop gives the compiled loop's mesh.  So it
 diagnoses Basic_aft and smoothing, before the minimum-angle pass (``min_angle=None``
 unless given: the pass adds vertices of its own), and without the scaffold
 (``scaffold=False`` in both runs: the Python loop never plants it, and its removals
@@ -174,13 +176,13 @@ def diagnose(
     options = {"min_angle": None, **options, "scaffold": False}
     plain = generate(domain, size, **{**options, "smooth": 0, "strategy": rec})
     mesh = generate(domain, size, **options)
-    if len(plain.points) != len(mesh.points):
+    if len(plain.points) + mesh.info["valence_splits"] != len(mesh.points):
         raise RuntimeError("the two meshes have different vertices: cannot compare them")
     index = _vertex_index(plain.points)
     q = triangle_quality(mesh.points, mesh.triangles)
     bad = np.flatnonzero(q["radius_ratio"] < threshold)
     q0 = triangle_quality(plain.points, plain.triangles)
-    was_bad = _bad_around(plain.triangles, q0["radius_ratio"] < threshold, len(plain.points))
+    was_bad = _bad_around(plain.triangles, q0["radius_ratio"] < threshold, len(mesh.points))
     on_segment = np.zeros(len(mesh.points), dtype=bool)
     on_segment[mesh.segments.ravel()] = True
     t = mesh.triangles[bad]
