@@ -32,11 +32,11 @@
 #
 # Termination: in exact arithmetic, Ruppert's argument with these two rules bounds the
 # insertions for bounds up to about 26.5 degrees (and in practice to about 33.8).  In
-# floating point the pass is also capped: no work on edges shorter than REFINE_TINY_ULPS
-# units in the last place of the coordinates, at most max_triangles triangles (formula
-# (4) wins over the bound), and at most REFINE_CAP_PER_TRIANGLE insertions per triangle
-# of the mesh it started from.  Each loop step inserts a vertex or consumes a queue
-# entry, so the loop is finite.
+# floating point the pass is also capped: no work on edges shorter, or triangles
+# thinner, than REFINE_TINY_ULPS units in the last place of the coordinates, at most
+# max_triangles triangles (formula (4) wins over the bound), and at most
+# REFINE_CAP_PER_TRIANGLE insertions per triangle of the mesh it started from.  Each
+# loop step inserts a vertex or consumes a queue entry, so the loop is finite.
 
 #
 # Uses: halfedge.pxd; aft.pxd (Aft); predicates.pxi (orient2d, incircle);
@@ -63,8 +63,8 @@ cdef enum:
 # A float bad-angle test errs by a few 1e-16; triangles within this relative margin of
 # the bound count as bad, so every triangle left unrefined is good in exact arithmetic.
 cdef double REFINE_ANGLE_MARGIN = 1e-12
-# Edges shorter than this many ulps of the largest coordinate are not refined: a point
-# placed between their ends is mostly rounding.
+# Edges shorter, and triangles thinner, than this many ulps of the largest coordinate
+# are not refined: a point placed between their ends is mostly rounding.
 cdef double REFINE_TINY_ULPS = 4096.0
 # Last-resort guard: insertions per triangle of the mesh the pass started from (Ruppert's
 # bound is proportional to the mesh size; this is far above what it inserts in practice).
@@ -194,9 +194,36 @@ cdef bint _points_bad(Refine* R, const double* a, const double* b,
     return _angle_below(b, c, a, R.c2_bad)
 
 
+cdef inline int _bad_edge(Refine* R, Tri* T, int t) noexcept nogil:
+    """_shortest_edge(T, t) when triangle t is bad, else NONE: _angle_below at the
+    corner opposite that edge, from one load of the three points.  With D_k the
+    vector along edge k, the corner's two sides are D_(k+2) and -D_(k+1); negating
+    is exact and so are the products' signs, so every value and the answer are
+    those of _shortest_edge and _angle_below (the scans run over every triangle, up
+    to four times a call)."""
+    cdef const double* p0 = P(T, T.tv[3 * t])
+    cdef const double* p1 = P(T, T.tv[3 * t + 1])
+    cdef const double* p2 = P(T, T.tv[3 * t + 2])
+    cdef double x0 = p1[0] - p0[0], y0 = p1[1] - p0[1]
+    cdef double x1 = p2[0] - p1[0], y1 = p2[1] - p1[1]
+    cdef double x2 = p0[0] - p2[0], y2 = p0[1] - p2[1]
+    cdef double d0 = x0 * x0 + y0 * y0, d1 = x1 * x1 + y1 * y1, d2 = x2 * x2 + y2 * y2
+    cdef double dot
+    if d1 < d0:
+        if d2 < d1:     # edge 2; its corner's sides are D_1 and -D_0
+            dot = x1 * x0 + y1 * y0
+            return 3 * t + 2 if dot < 0 and dot * dot > R.c2_bad * d1 * d0 else NONE
+        dot = x0 * x2 + y0 * y2     # edge 1: D_0 and -D_2
+        return 3 * t + 1 if dot < 0 and dot * dot > R.c2_bad * d0 * d2 else NONE
+    if d2 < d0:
+        dot = x1 * x0 + y1 * y0
+        return 3 * t + 2 if dot < 0 and dot * dot > R.c2_bad * d1 * d0 else NONE
+    dot = x2 * x1 + y2 * y1         # edge 0: D_2 and -D_1
+    return 3 * t if dot < 0 and dot * dot > R.c2_bad * d2 * d1 else NONE
+
+
 cdef inline bint _is_bad(Refine* R, Tri* T, int t) noexcept nogil:
-    cdef int e = _shortest_edge(T, t)
-    return _angle_below(P(T, T.tv[prv(e)]), P(T, T.tv[e]), P(T, T.tv[nxt(e)]), R.c2_bad)
+    return _bad_edge(R, T, t) != NONE
 
 
 # ---------------------------------------------------------------- queues
@@ -271,10 +298,12 @@ cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
     """After v was put on a segment: queue the segments around v that a vertex
     encroaches (the two halves by their apexes, the far edges of v's star by v), but
     not a piece encroached by a vertex on another chain meeting it at a small angle:
-    near an apex a few ulps wide every split would encroach the other chain again."""
+    near an apex a few ulps wide every split would encroach the other chain again.
+    Nor in a triangle below the resolution (_below_resolution): across a gap thinner
+    than that, each split would encroach the other side again until the cap."""
     cdef int e0 = T.vhe[v], e = e0, f, g, guard = 0, k
     while True:
-        if T.tstate[e // 3] == T_MESHED:
+        if T.tstate[e // 3] == T_MESHED and not _below_resolution(R, T, e // 3):
             f = nxt(e)                  # the edge of v's triangle opposite v
             if (T.eflag[f] & E_SEGMENT) and _encroaches(
                     P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt(f)])) and not _across_apex(
@@ -912,10 +941,26 @@ cdef double _tiny_length(Tri* T) noexcept nogil:
     return REFINE_TINY_ULPS * big * 2.220446049250313e-16
 
 
+cdef bint _below_resolution(Refine* R, Tri* T, int t) noexcept nogil:
+    """Triangle t has an edge shorter than R.tiny, or is thinner than R.tiny (its
+    smallest height, twice its area over its longest edge): then no point placed
+    for it is more than rounding, and it is left as it is.  (A region or a gap
+    between segments narrower than that is made only of such triangles; splitting
+    the segments along it would only stop at the insertion cap.)"""
+    cdef const double* a = P(T, T.tv[3 * t])
+    cdef const double* b = P(T, T.tv[3 * t + 1])
+    cdef const double* c = P(T, T.tv[3 * t + 2])
+    cdef double ab = _d2(a, b), bc = _d2(b, c), ca = _d2(c, a), t2 = R.tiny * R.tiny
+    cdef double cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+    if ab < t2 or bc < t2 or ca < t2:
+        return True
+    return cross * cross < t2 * max(ab, max(bc, ca))
+
+
 cdef int _refine_step(Refine* R, Aft* A, Tri* T) noexcept nogil:
     """One step of the loop: split a queued segment, or work on a queued triangle.
     Returns 1 to go on, 0 when the queues are empty, or an error."""
-    cdef int t, res, u, w
+    cdef int t, res, u, w, e
     if R.sq_n > 0:
         R.sq_n -= 1
         u = R.sq[2 * R.sq_n]
@@ -925,11 +970,10 @@ cdef int _refine_step(Refine* R, Aft* A, Tri* T) noexcept nogil:
     t = _pop_tri(R, T)
     if t == NONE:
         return 0
-    if not _is_bad(R, T, t) or _excepted(R, T, _shortest_edge(T, t)):
+    e = _bad_edge(R, T, t)
+    if e == NONE or _excepted(R, T, e):
         return 1
-    if _d2(P(T, T.tv[3 * t]), P(T, T.tv[nxt(3 * t)])) < R.tiny * R.tiny or _d2(
-            P(T, T.tv[3 * t + 1]), P(T, T.tv[3 * t + 2])) < R.tiny * R.tiny or _d2(
-            P(T, T.tv[3 * t + 2]), P(T, T.tv[3 * t])) < R.tiny * R.tiny:
+    if _below_resolution(R, T, t):
         return 1
     res = _refine_triangle(R, A, T, t)
     if res < 0:
@@ -945,12 +989,15 @@ cdef int _refine_step(Refine* R, Aft* A, Tri* T) noexcept nogil:
 cdef int _final_scan(Refine* R, Tri* T) noexcept nogil:
     """Count the triangles still below the bound: excepted ones (forced by a small
     input angle) and the others."""
-    cdef int t
+    cdef int t, e
     R.excepted = 0
     R.unresolved = 0
     for t in range(T.nt):
-        if T.tstate[t] == T_MESHED and _is_bad(R, T, t):
-            if _excepted(R, T, _shortest_edge(T, t)):
+        if T.tstate[t] != T_MESHED:
+            continue
+        e = _bad_edge(R, T, t)
+        if e != NONE:
+            if _excepted(R, T, e):
                 R.excepted += 1
             else:
                 R.unresolved += 1
@@ -961,11 +1008,20 @@ cdef int refine_mesh(Refine* R, Aft* A, Tri* T) noexcept nogil:
     """The minimum-angle pass over the meshed triangles (see the top of this file).
     R holds the bound and the options; it receives the counts.  Returns 0 or an
     error."""
+    cdef int res = _refine_loop(R, A, T)
+    if res <= 0:
+        return res                  # an error, or nothing is bad: the counts stay 0
+    return _final_scan(R, T)
+
+
+cdef int _refine_loop(Refine* R, Aft* A, Tri* T) noexcept nogil:
+    """refine_mesh without the final count: 1 when there were bad triangles to work
+    on, 0 when none, or an error."""
     cdef int res, steps = 0
     R.max_triangles = A.max_triangles
     res = _scan_bad(R, T)
     if res <= 0:
-        return res                  # nothing is bad: the counts stay 0
+        return res
     R.tiny = _tiny_length(T)
     R.max_insert = max(REFINE_CAP_MIN, REFINE_CAP_PER_TRIANGLE * R.n_meshed)
     if R.vend == NULL:
@@ -984,7 +1040,7 @@ cdef int refine_mesh(Refine* R, Aft* A, Tri* T) noexcept nogil:
         steps += 1
         if steps % 4096 == 0 and check_signals(A) != 0:
             return ERR_INTERRUPTED
-    return _final_scan(R, T)
+    return 1
 
 
 cdef int refine_settled(Refine* R, Aft* A, Tri* T, int first_movable, bint slide,
@@ -994,12 +1050,15 @@ cdef int refine_settled(Refine* R, Aft* A, Tri* T, int first_movable, bint slide
     settle_refined: Basic_aft's vertices, first_movable on, and the pass's interior
     ones move; with `slide`, the points inside a chain slide), then refine_mesh again,
     so that the bound holds for the final mesh (see the top of this file).  Returns 0
-    or an error."""
+    or an error.  The counts are those of the last run (the first run's final count
+    is skipped when a second run follows)."""
     cdef int first_new = T.nv, res
     cdef int rounds = min(REFINE_SETTLE_ROUNDS, smooth_rounds)
-    res = refine_mesh(R, A, T)
-    if res < 0 or rounds <= 0 or T.nv == first_new or R.stop != STOP_NONE:
-        return res
+    res = _refine_loop(R, A, T)
+    if res <= 0:
+        return res                  # an error, or nothing is bad: the counts stay 0
+    if rounds <= 0 or T.nv == first_new or R.stop != STOP_NONE:
+        return _final_scan(R, T)
     res = settle_refined(A, T, first_new, first_movable, R.vend if slide else NULL, rounds)
     if res < 0:
         return res
