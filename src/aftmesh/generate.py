@@ -254,7 +254,9 @@ def generate(
         an angle).  The pass is proven to terminate up to about 26.5 degrees and does
         so in practice up to about 33.8, so values above 34 are refused; it is also
         capped (max_triangles wins over the bound; a last-resort cap of 8 insertions
-        per triangle).  With ``split_boundary=False`` it splits no input edge and
+        per triangle), and leaves triangles with an edge shorter or a height smaller
+        than 4096 ulps of the largest coordinate (a region or gap that narrow) as
+        they are, counted as unresolved.  With ``split_boundary=False`` it splits no input edge and
         inserts a point only where all the triangles it makes meet the bound (the mesh
         never gets worse; the bound may then stay out of reach); with ``greedy`` or
         ``swaps=False`` it does not run.  ``info['min_angle']`` says what it did:
