@@ -943,10 +943,11 @@ cdef double _tiny_length(Tri* T) noexcept nogil:
 
 cdef bint _below_resolution(Refine* R, Tri* T, int t) noexcept nogil:
     """Triangle t has an edge shorter than R.tiny, or is thinner than R.tiny (its
-    smallest height, twice its area over its longest edge): then no point placed
-    for it is more than rounding, and it is left as it is.  (A region or a gap
-    between segments narrower than that is made only of such triangles; splitting
-    the segments along it would only stop at the insertion cap.)"""
+    smallest height, twice its area over its longest edge): its small angle comes
+    from points closer together, or closer to a line through two others, than the
+    pass resolves, and it is left as it is.  (A region or a gap between segments
+    that narrow is made only of such triangles; points put for them split the
+    segments on both sides in turn, down to the insertion cap.)"""
     cdef const double* a = P(T, T.tv[3 * t])
     cdef const double* b = P(T, T.tv[3 * t + 1])
     cdef const double* c = P(T, T.tv[3 * t + 2])

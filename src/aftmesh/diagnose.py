@@ -26,11 +26,11 @@ final mesh whose radius ratio is below a threshold with the first class that app
 It needs the same vertex numbering in both meshes: smoothing moves vertices and adds
 only the valence splits' points, numbered after all the others (``info
 ["valence_splits"]`` of them: no triangle was bad around them before smoothing), and
-the Python loop gives the compiled loop's mesh.  So it
-diagnoses Basic_aft and smoothing, before the minimum-angle pass (``min_angle=None``
-unless given: the pass adds vertices of its own), and without the scaffold
-(``scaffold=False`` in both runs: the Python loop never plants it, and its removals
-change where the compiled loop's fronts put their points).
+the Python loop gives the compiled loop's mesh.  So it diagnoses Basic_aft and
+smoothing, before the minimum-angle pass (``min_angle=None`` unless given: the pass
+adds vertices of its own), and without the scaffold (``scaffold=False`` in both runs:
+the Python loop never plants it, and its removals change where the compiled loop's
+fronts put their points).
 """
 
 from __future__ import annotations

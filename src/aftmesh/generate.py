@@ -256,10 +256,10 @@ def generate(
         capped (max_triangles wins over the bound; a last-resort cap of 8 insertions
         per triangle), and leaves triangles with an edge shorter or a height smaller
         than 4096 ulps of the largest coordinate (a region or gap that narrow) as
-        they are, counted as unresolved.  With ``split_boundary=False`` it splits no input edge and
-        inserts a point only where all the triangles it makes meet the bound (the mesh
-        never gets worse; the bound may then stay out of reach); with ``greedy`` or
-        ``swaps=False`` it does not run.  ``info['min_angle']`` says what it did:
+        they are, counted as unresolved.  With ``split_boundary=False`` it splits no
+        input edge and inserts a point only where all the triangles it makes meet the
+        bound (the mesh never gets worse; the bound may then stay out of reach); with
+        ``greedy`` or ``swaps=False`` it does not run.  ``info['min_angle']`` says what it did:
         ``bound``, ``reached`` (no triangle below the bound but the excepted ones),
         ``excepted_triangles``, ``unresolved_triangles``, ``inserted`` (of which
         ``segment_splits`` on segments; both runs together), ``stopped_by`` (None,
