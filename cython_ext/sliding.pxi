@@ -27,8 +27,9 @@
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
 # Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
-# _cost_of_shapes, _better, _ring_ccw, _legalize_around, OPT_SKIP, OPT_DESCENT,
-# OPT_DESCENT_STEPS, OPT_RING_CAP, OPT_INVALID); smoothing.pxi (_shape).
+# _cost_of_shapes, _better, _settled, _ring_ccw, _legalize_around, OPT_SKIP,
+# OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP, OPT_INVALID);
+# smoothing.pxi (_shape).
 from halfedge cimport *
 from libc.math cimport sqrt, INFINITY
 
@@ -103,21 +104,23 @@ cdef inline double _param(const Line* G, double x, double y) noexcept nogil:
 cdef void _descend_on_line(const Ring* R, const Line* G, double worst0, double* bt,
                            double* bx, double* by, double* best) noexcept nogil:
     """optimize.pxi's _descend restricted to the line: up to OPT_DESCENT_STEPS steps
-    along it against the cost's slope, each the longest that improves."""
+    along it against the cost's slope, each the longest that improves, until one
+    gains little (_settled)."""
     cdef double gx, gy, slope, c, x, y, t
     cdef int k, it, k0 = 0
-    cdef bint stepped
+    cdef bint stepped, settled = False
     for it in range(OPT_DESCENT_STEPS):
         _cost_gradient(R, bx[0], by[0], &gx, &gy)
         slope = gx * G.dx + gy * G.dy
         if not (slope != 0.0 and slope > -INFINITY and slope < INFINITY):
             return                      # flat, or at an invalid place
         stepped = False
-        for k in range(k0, 4):
+        for k in range(k0, OPT_DESCENT_LENGTHS):
             t = bt[0] - (OPT_DESCENT[k] * G.step if slope > 0 else -OPT_DESCENT[k] * G.step)
             _on_line(G, t, &x, &y)
             c = _cost_at(R, x, y, worst0)
             if _better(c, best[0]):
+                settled = _settled(c, best[0])
                 bt[0] = t
                 bx[0] = x
                 by[0] = y
@@ -125,7 +128,7 @@ cdef void _descend_on_line(const Ring* R, const Line* G, double worst0, double* 
                 stepped = True
                 k0 = k
                 break
-        if not stepped:
+        if not stepped or settled:
             return
 
 
