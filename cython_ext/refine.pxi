@@ -169,19 +169,6 @@ cdef inline bint _angle_below(const double* a, const double* p, const double* q,
     return dot > 0 and dot * dot > c2 * (ux * ux + uy * uy) * (vx * vx + vy * vy)
 
 
-cdef int _shortest_edge(Tri* T, int t) noexcept nogil:
-    """The half-edge of triangle t with the shortest length (opposite its smallest
-    angle)."""
-    cdef int k, best = 3 * t
-    cdef double d, bd = -1.0
-    for k in range(3):
-        d = _d2(P(T, T.tv[3 * t + k]), P(T, T.tv[nxt(3 * t + k)]))
-        if bd < 0 or d < bd:
-            bd = d
-            best = 3 * t + k
-    return best
-
-
 cdef bint _points_bad(Refine* R, const double* a, const double* b,
                       const double* c) noexcept nogil:
     """Whether the triangle a, b, c has an angle below the bound (at the corner
@@ -195,31 +182,37 @@ cdef bint _points_bad(Refine* R, const double* a, const double* b,
 
 
 cdef inline int _bad_edge(Refine* R, Tri* T, int t) noexcept nogil:
-    """_shortest_edge(T, t) when triangle t is bad, else NONE: _angle_below at the
-    corner opposite that edge, from one load of the three points.  With D_k the
-    vector along edge k, the corner's two sides are D_(k+2) and -D_(k+1); negating
-    is exact and so are the products' signs, so every value and the answer are
-    those of _shortest_edge and _angle_below (the scans run over every triangle, up
+    """The shortest half-edge of triangle t (the first of equal ones) when the angle
+    opposite it is below the bound (_angle_below at that corner), else NONE, from
+    one load of the three points.  With D_k the vector along edge k, the corner's
+    sides are D_(k+2) and -D_(k+1): negating is exact and so are the products'
+    signs, so every value is _angle_below's (the scans run over every triangle, up
     to four times a call)."""
     cdef const double* p0 = P(T, T.tv[3 * t])
     cdef const double* p1 = P(T, T.tv[3 * t + 1])
     cdef const double* p2 = P(T, T.tv[3 * t + 2])
-    cdef double x0 = p1[0] - p0[0], y0 = p1[1] - p0[1]
-    cdef double x1 = p2[0] - p1[0], y1 = p2[1] - p1[1]
-    cdef double x2 = p0[0] - p2[0], y2 = p0[1] - p2[1]
-    cdef double d0 = x0 * x0 + y0 * y0, d1 = x1 * x1 + y1 * y1, d2 = x2 * x2 + y2 * y2
+    cdef double x[3]
+    cdef double y[3]
+    cdef double d[3]
     cdef double dot
-    if d1 < d0:
-        if d2 < d1:     # edge 2; its corner's sides are D_1 and -D_0
-            dot = x1 * x0 + y1 * y0
-            return 3 * t + 2 if dot < 0 and dot * dot > R.c2_bad * d1 * d0 else NONE
-        dot = x0 * x2 + y0 * y2     # edge 1: D_0 and -D_2
-        return 3 * t + 1 if dot < 0 and dot * dot > R.c2_bad * d0 * d2 else NONE
-    if d2 < d0:
-        dot = x1 * x0 + y1 * y0
-        return 3 * t + 2 if dot < 0 and dot * dot > R.c2_bad * d1 * d0 else NONE
-    dot = x2 * x1 + y2 * y1         # edge 0: D_2 and -D_1
-    return 3 * t if dot < 0 and dot * dot > R.c2_bad * d2 * d1 else NONE
+    cdef int k, a, b
+    x[0] = p1[0] - p0[0]
+    y[0] = p1[1] - p0[1]
+    x[1] = p2[0] - p1[0]
+    y[1] = p2[1] - p1[1]
+    x[2] = p0[0] - p2[0]
+    y[2] = p0[1] - p2[1]
+    for k in range(3):
+        d[k] = x[k] * x[k] + y[k] * y[k]
+    k = 0
+    if d[1] < d[0]:
+        k = 2 if d[2] < d[1] else 1
+    elif d[2] < d[0]:
+        k = 2
+    a = (k + 2) % 3
+    b = (k + 1) % 3
+    dot = x[a] * x[b] + y[a] * y[b]
+    return 3 * t + k if dot < 0 and dot * dot > R.c2_bad * d[a] * d[b] else NONE
 
 
 cdef inline bint _is_bad(Refine* R, Tri* T, int t) noexcept nogil:
@@ -229,9 +222,16 @@ cdef inline bint _is_bad(Refine* R, Tri* T, int t) noexcept nogil:
 # ---------------------------------------------------------------- queues
 
 cdef int _push_tri(Refine* R, Tri* T, int t) noexcept nogil:
-    cdef int64_t i, n
+    """Queue triangle t if it is meshed and bad; 0 or ERR_NOMEM."""
     if T.tstate[t] != T_MESHED or not _is_bad(R, T, t):
         return 0
+    return _enqueue_tri(R, T, t)
+
+
+cdef int _enqueue_tri(Refine* R, Tri* T, int t) noexcept nogil:
+    """Queue triangle t (with its vertices, so that _pop_tri can tell whether it
+    still exists); 0 or ERR_NOMEM."""
+    cdef int64_t i, n
     if R.tq_head + R.tq_n + 1 > R.tq_cap:
         if R.tq_head > 0:           # slide the live entries to the front
             for i in range(4 * R.tq_n):
@@ -868,9 +868,10 @@ cdef int _split_all(Refine* R, Aft* A, Tri* T, int32_t* segs, int n) noexcept no
     return ACT_SPLIT if done else ACT_DROPPED
 
 
-cdef int _refine_triangle(Refine* R, Aft* A, Tri* T, int t) noexcept nogil:
-    """Insert the off-centre of bad triangle t, or split the segments in its way."""
-    cdef int e = _shortest_edge(T, t), where = NONE, res, loc, v, t1 = NONE
+cdef int _refine_triangle(Refine* R, Aft* A, Tri* T, int t, int e) noexcept nogil:
+    """Insert the off-centre of bad triangle t (e: its shortest half-edge, from
+    _bad_edge), or split the segments in its way."""
+    cdef int where = NONE, res, loc, v, t1 = NONE
     cdef int32_t seg[2]
     cdef double M[2]
     cdef double X[2]
@@ -928,7 +929,7 @@ cdef int _scan_bad(Refine* R, Tri* T) noexcept nogil:
             R.n_meshed += 1
             if _is_bad(R, T, t):
                 nbad += 1
-                if _push_tri(R, T, t):
+                if _enqueue_tri(R, T, t):
                     return ERR_NOMEM
     return nbad
 
@@ -976,7 +977,7 @@ cdef int _refine_step(Refine* R, Aft* A, Tri* T) noexcept nogil:
         return 1
     if _below_resolution(R, T, t):
         return 1
-    res = _refine_triangle(R, A, T, t)
+    res = _refine_triangle(R, A, T, t, e)
     if res < 0:
         return res
     if res == ACT_SPLIT:
