@@ -725,7 +725,7 @@ cdef int add_triangle(Aft* A, Tri* T, int t) noexcept nogil:
     for k in range(3):
         e = 3 * t + k
         f = T.twin[e]
-        if T.tstate[f // 3] == T_UNMESHED and not (T.eflag[e] & E_SEGMENT):
+        if T.tstate[tri_of(f)] == T_UNMESHED and not (T.eflag[e] & E_SEGMENT):
             if queue_push(A, T, f):
                 return ERR_NOMEM
     if A.swaps:

@@ -94,14 +94,17 @@ cdef struct Tri:
     uint8_t* vdirty
 
 
+# Half-edges are never negative here (callers test for NONE first), and unsigned
+# division by 3 compiles to a multiply and a shift, where signed division also needs
+# the sign's correction: these run in every rotation and walk.
 cdef inline int nxt(int e) noexcept nogil:
-    return e - 2 if e % 3 == 2 else e + 1
+    return e - 2 if <uint32_t> e % 3 == 2 else e + 1
 
 cdef inline int prv(int e) noexcept nogil:
-    return e + 2 if e % 3 == 0 else e - 1
+    return e + 2 if <uint32_t> e % 3 == 0 else e - 1
 
 cdef inline int tri_of(int e) noexcept nogil:
-    return e // 3
+    return <int> (<uint32_t> e // 3)
 
 cdef inline double* P(Tri* T, int v) noexcept nogil:
     return &T.xy[2 * v]

@@ -127,7 +127,7 @@ cdef int _gather_ring(Tri* T, int v, int e0, Ring* R, double* q) noexcept nogil:
     while True:
         u = T.tv[nxt(e)]
         w = T.tv[prv(e)]
-        if u < 0 or w < 0 or T.tstate[e // 3] != T_MESHED or n >= OPT_RING_CAP:
+        if u < 0 or w < 0 or T.tstate[tri_of(e)] != T_MESHED or n >= OPT_RING_CAP:
             return 0
         pu = P(T, u)
         pw = P(T, w)
@@ -299,11 +299,66 @@ cdef bint _ring_needs_flips(Tri* T, int v) noexcept nogil:
     same test on the same edges of the unchanged mesh, without the stack: nearly every
     move leaves them all legal (one flip in about 200 moves on earcut-rain), and when
     one is illegal the stack run tests again from the start, so the flips, and the
-    mesh, are exactly those of the stack run alone."""
+    mesh, are exactly those of the stack run alone.
+
+    It is illegal_meshed_edge's test, each predicate on the same points in the same
+    order, taken in one walk around v: each ring vertex is read once, and a spoke's
+    two triangles are the walk's current and previous ones (their states known), so
+    the angles facing it come from the two triangles' own passes."""
     cdef int e0 = T.vhe[v], e = e0
+    cdef double* pv = P(T, v)
+    cdef double* pu
+    cdef double* pw
+    cdef double* pu_prev = NULL     # the previous triangle's u: across e's spoke
+    cdef double* pu0 = NULL         # the first triangle's u and w, for e0's spoke
+    cdef double* pw0 = NULL
+    cdef bint meshed, meshed_prev = False, meshed0 = False
+    cdef bint at_u_prev = False     # the previous triangle's angle at its u is acute
     while True:
-        if illegal_meshed_edge(T, e) or illegal_meshed_edge(T, nxt(e)):
-            return True
+        meshed = T.tstate[tri_of(e)] == T_MESHED
+        if meshed:
+            pu = P(T, T.tv[nxt(e)])
+            pw = P(T, T.tv[prv(e)])
+            if _opposite_illegal(T, nxt(e), pu, pw, pv):
+                return True
+            if e == e0:
+                pu0 = pu
+                pw0 = pw
+                meshed0 = True
+            elif meshed_prev and _spoke_illegal(T, e, pv, pu, pw, pu_prev, at_u_prev):
+                return True
+            at_u_prev = surely_acute(pw, pv, pu)
+            pu_prev = pu
+        meshed_prev = meshed
         e = T.twin[prv(e)]
         if e == e0:
-            return False
+            break
+    # e0's spoke: its other triangle is the walk's last
+    return (meshed0 and meshed_prev
+            and _spoke_illegal(T, e0, pv, pu0, pw0, pu_prev, at_u_prev))
+
+
+cdef inline bint _spoke_illegal(Tri* T, int e, const double* pv, const double* pu,
+                                const double* pw, const double* pd,
+                                bint at_d_acute) noexcept nogil:
+    # illegal_meshed_edge(T, e) for the spoke e = v -> u of the meshed triangle
+    # (v, u, w), whose twin's meshed triangle has apex d (at_d_acute: its angle at d
+    # is surely acute, surely_acute(u, v, d))
+    if T.eflag[e] & (E_SEGMENT | E_FIXED):
+        return False
+    if surely_acute(pv, pu, pw) and at_d_acute:
+        return False
+    return incircle(pv, pu, pw, pd) > 0
+
+
+cdef inline bint _opposite_illegal(Tri* T, int o, const double* pu, const double* pw,
+                                   const double* pv) noexcept nogil:
+    # illegal_meshed_edge(T, o) for the edge o = u -> w of the meshed triangle (v, u, w)
+    cdef int f = T.twin[o]
+    cdef const double* pd
+    if T.tstate[tri_of(f)] != T_MESHED or T.eflag[o] & (E_SEGMENT | E_FIXED):
+        return False
+    pd = P(T, T.tv[prv(f)])
+    if surely_acute(pu, pw, pv) and surely_acute(pw, pu, pd):
+        return False
+    return incircle(pu, pw, pv, pd) > 0

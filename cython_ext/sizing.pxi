@@ -97,21 +97,28 @@ cdef inline double _side(const double* a, const double* b, double x, double y) n
     return (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
 
 
-cdef int size_locate(SizeField* S, double x, double y) noexcept nogil:
+cdef int size_locate(SizeField* S, double x, double y, double* side,
+                     bint* sides_known) noexcept nogil:
     """The background triangle holding (x, y), or the last one a walk towards it
     reached (at the hull, or after as many steps as there are triangles: rounding can
-    make a walk circle, and any nearby triangle gives a good enough size)."""
+    make a walk circle, and any nearby triangle gives a good enough size).  When the
+    walk ended inside it, side[k] holds _side of (x, y) from its edge k (opposite its
+    corner k) and sides_known is set: size_at's weights, already computed."""
     cdef int t = S.hint, step, k, j, n, first = 0
     cdef const double* c
+    sides_known[0] = False
     if t < 0 or t >= S.nt:
         t = 0
     for step in range(S.nt):
         c = &S.txy[6 * t]
         n = -1
+        sides_known[0] = True
         for j in range(3):
             k = _MOD3[first + j]    # rotate the first edge tried: no walk cycles for good
-            if _side(&c[2 * _MOD3[k + 1]], &c[2 * _MOD3[k + 2]], x, y) < 0.0:
+            side[k] = _side(&c[2 * _MOD3[k + 1]], &c[2 * _MOD3[k + 2]], x, y)
+            if side[k] < 0.0:
                 n = S.nb[3 * t + k]
+                sides_known[0] = False
                 break
         if n < 0:
             break
@@ -138,15 +145,17 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     cdef int t, k, a
     cdef double lam[3]
     cdef double s = 0.0, h = 0.0, c
+    cdef bint known
     cdef const int32_t* v
     cdef const double* p
     if S.nt == 0:
         return S.constant
-    t = size_locate(S, x, y)
+    t = size_locate(S, x, y, lam, &known)
     v = &S.tv[3 * t]
     p = &S.txy[6 * t]
     for k in range(3):
-        lam[k] = _side(&p[2 * _MOD3[k + 1]], &p[2 * _MOD3[k + 2]], x, y)
+        if not known:
+            lam[k] = _side(&p[2 * _MOD3[k + 1]], &p[2 * _MOD3[k + 2]], x, y)
         if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
             lam[k] = 0.0
         s += lam[k]

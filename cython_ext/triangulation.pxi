@@ -317,7 +317,7 @@ cdef inline bint illegal_meshed_edge(Tri* T, int e) noexcept nogil:
     cdef double* pb
     cdef double* pc
     cdef double* pd
-    if T.tstate[e // 3] != T_MESHED or T.tstate[f // 3] != T_MESHED:
+    if T.tstate[tri_of(e)] != T_MESHED or T.tstate[tri_of(f)] != T_MESHED:
         return False
     if T.eflag[e] & (E_SEGMENT | E_FIXED):
         return False

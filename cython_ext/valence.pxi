@@ -93,7 +93,7 @@ cdef int valence_flips(Tri* T, int first_movable, uint8_t* touched) noexcept nog
         return ERR_NOMEM
     for e in range(3 * T.nt):
         f = T.twin[e]
-        if f < e or T.tstate[e // 3] != T_MESHED or T.tstate[f // 3] != T_MESHED:
+        if f < e or T.tstate[tri_of(e)] != T_MESHED or T.tstate[tri_of(f)] != T_MESHED:
             continue
         if T.eflag[e] & (E_SEGMENT | E_FIXED):
             continue
