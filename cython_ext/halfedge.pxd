@@ -89,14 +89,21 @@ cdef struct Tri:
     # where the last ERR_CROSSING came from: new edge (err_a, err_b) hit edge (err_u, err_v)
     int32_t err_a, err_b, err_u, err_v
     int32_t err_seg     # ... which is a piece of input segment err_seg (-1: none)
-    # while smoothing runs, per vertex: 1 when its ring may have changed since it was
-    # last judged (legalize_meshed's flips set it for their four corners); else NULL
+    # while smoothing runs, per vertex: a VertexMark (legalize_meshed's flips set
+    # V_CHANGED for their four corners); else NULL
     uint8_t* vdirty
 
 
 # Half-edges are never negative here (callers test for NONE first), and unsigned
 # division by 3 compiles to a multiply and a shift, where signed division also needs
 # the sign's correction: these run in every rotation and walk.
+cdef enum:
+    # VertexMarks: what smoothing knows of a vertex since it was last judged
+    V_SETTLED = 0       # nothing around it changed: judged again, it would stay
+    V_CHANGED = 1       # its ring may have changed (it or a neighbour moved, a flip)
+    V_OWES_DESCENT = 2  # it stayed where only the neighbours' mean was tried
+
+
 cdef inline int nxt(int e) noexcept nogil:
     return e - 2 if <uint32_t> e % 3 == 2 else e + 1
 

@@ -27,8 +27,9 @@
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
 # Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
-# _cost_of_shapes, _better, _settled, _ring_ccw, _legalize_around, OPT_SKIP,
-# OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP, OPT_INVALID);
+# _cost_of_shapes, _better, _settled, _ring_ccw, _stayed, _legalize_around, OPT_SKIP,
+# OPT_DESCEND_BELOW, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP,
+# OPT_INVALID);
 # smoothing.pxi (_shape).
 from halfedge cimport *
 from libc.math cimport sqrt, INFINITY
@@ -132,10 +133,11 @@ cdef void _descend_on_line(const Ring* R, const Line* G, double worst0, double* 
             return
 
 
-cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
+cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps, bint descend) noexcept nogil:
     """Move split point v along the line of its chain's ends a, b to the best of the
-    places tried (see the top of this file); then, with `swaps`, restore the CDT
-    around it.  Returns 1 if v moved, 0 if not, or an error."""
+    places tried (see the top of this file; without `descend`, the neighbours' mean's
+    foot on the line only, as in _optimize_vertex); then, with `swaps`, restore the
+    CDT around it.  Returns 1 if v moved, 0 if not, or an error."""
     cdef int s = _fan_start(T, v), n
     cdef Ring R
     cdef Line G
@@ -143,6 +145,7 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
     cdef double q[OPT_RING_CAP]
     cdef double worst0, L, c, best, x, y, t, bt, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
+    cdef bint descended
     if s == NONE:
         return 0
     n = _gather_fan(T, v, s, &R, q)
@@ -171,13 +174,15 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps) noexcept nogil:
         bt = t
         bx = x
         by = y
-    _descend_on_line(&R, &G, worst0, &bt, &bx, &by, &best)
+    descended = descend or worst0 < OPT_DESCEND_BELOW
+    if descended:
+        _descend_on_line(&R, &G, worst0, &bt, &bx, &by, &best)
     if bx == cx and by == cy:
-        return 0
+        return _stayed(T, v, descended)
     T.xy[2 * v] = bx
     T.xy[2 * v + 1] = by
     if not _ring_ccw(T, v):
         T.xy[2 * v] = cx
         T.xy[2 * v + 1] = cy
-        return 0
+        return _stayed(T, v, descended)
     return _legalize_around(T, v) if swaps else 1

@@ -354,10 +354,10 @@ cdef int legalize_meshed_with(Tri* T, int nstack, flip_hook hook, void* ctx) noe
             t0 = e // 3
             t1 = f // 3
             if T.vdirty != NULL:
-                T.vdirty[T.tv[e]] = 1
-                T.vdirty[T.tv[nxt(e)]] = 1
-                T.vdirty[T.tv[prv(e)]] = 1
-                T.vdirty[T.tv[prv(f)]] = 1
+                T.vdirty[T.tv[e]] = V_CHANGED
+                T.vdirty[T.tv[nxt(e)]] = V_CHANGED
+                T.vdirty[T.tv[prv(e)]] = V_CHANGED
+                T.vdirty[T.tv[prv(f)]] = V_CHANGED
             flip(T, e)
             if hook != NULL:
                 res = hook(ctx, T, t0)

@@ -117,7 +117,7 @@ cdef int valence_flips(Tri* T, int first_movable, uint8_t* touched) noexcept nog
         x[c] += 1
         x[d] += 1
         touched[a] = touched[b] = touched[c] = touched[d] = 1
-        T.vdirty[a] = T.vdirty[b] = T.vdirty[c] = T.vdirty[d] = 1
+        T.vdirty[a] = T.vdirty[b] = T.vdirty[c] = T.vdirty[d] = V_CHANGED
         flips += 1
     free(x)
     return flips

@@ -59,7 +59,7 @@ def generate(
     split_boundary: bool = True,
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
-    smooth: int = 3,
+    smooth: int = 4,
     slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
@@ -87,7 +87,7 @@ def generate(
     split_boundary: bool = True,
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
-    smooth: int = 3,
+    smooth: int = 4,
     slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
@@ -114,7 +114,7 @@ def generate(
     split_boundary: bool = True,
     gradation: float = DEFAULT_GRADATION,
     close_factor: float = 0.5,
-    smooth: int = 3,
+    smooth: int = 4,
     slide_boundary: bool = True,
     strategy: Strategy | None = None,
     progress: bool | Callable[[float], object] | None = None,
@@ -189,8 +189,9 @@ def generate(
     smooth : int
         Rounds of smoothing after the front has closed (0: none).  Each round tries,
         for every vertex Basic_aft created whose triangles are not all nearly
-        equilateral, the mean of its neighbours and then up to four steps along
-        the gradient, and moves it to the place that lowers the sum of 1/shape^2
+        equilateral, the mean of its neighbours, and the last round (and every round
+        next to a triangle of shape below 0.85) also up to four steps along the
+        gradient, and moves it to the place that lowers the sum of 1/shape^2
         of its triangles without making the worst of them worse, keeping every triangle
         counter-clockwise (exact); edge swaps around it then restore the constrained
         Delaunay property.  With ``slide_boundary``, a point that splits an input
