@@ -94,9 +94,6 @@ cdef struct Tri:
     uint8_t* vdirty
 
 
-# Half-edges are never negative here (callers test for NONE first), and unsigned
-# division by 3 compiles to a multiply and a shift, where signed division also needs
-# the sign's correction: these run in every rotation and walk.
 cdef enum:
     # VertexMarks: what smoothing knows of a vertex since it was last judged
     V_SETTLED = 0       # nothing around it changed: judged again, it would stay
@@ -104,6 +101,9 @@ cdef enum:
     V_OWES_DESCENT = 2  # it stayed where only the neighbours' mean was tried
 
 
+# Half-edges are never negative here (callers test for NONE first), and unsigned
+# division by 3 compiles to a multiply and a shift, where signed division also needs
+# the sign's correction: these run in every rotation and walk.
 cdef inline int nxt(int e) noexcept nogil:
     return e - 2 if <uint32_t> e % 3 == 2 else e + 1
 

@@ -234,11 +234,11 @@ cdef void _descend(const Ring* R, double L, double worst0, double* bx, double* b
 cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogil:
     """Move v to the best of the places tried (see the top of this file; without
     `descend`, the neighbours' mean only, unless a triangle of v is shaped worse than
-    OPT_DESCEND_BELOW) when that lowers the cost of its triangles
-    without lowering their worst shape, and every triangle stays counter-clockwise by
-    the exact orient2d; then, with `swaps`, restore the CDT around it.  A vertex that
-    may not move (see _gather_ring), or whose triangles are all shaped better than
-    OPT_SKIP, stays.  Returns 1 if v moved, 0 if not, or an error."""
+    OPT_DESCEND_BELOW) when that lowers the cost of its triangles without lowering
+    their worst shape, and every triangle stays counter-clockwise by the exact
+    orient2d; then, with `swaps`, restore the CDT around it.  A vertex that may not
+    move (see _gather_ring), or whose triangles are all shaped better than OPT_SKIP,
+    stays.  Returns 1 if v moved, 0 if not, or an error."""
     cdef int e0 = T.vhe[v], n
     cdef Ring R
     cdef double lap[2]
@@ -324,8 +324,8 @@ cdef bint _ring_needs_flips(Tri* T, int v) noexcept nogil:
     one is illegal the stack run tests again from the start, so the flips, and the
     mesh, are exactly those of the stack run alone.
 
-    It is illegal_meshed_edge's test, each predicate on the same points in the same
-    order, taken in one walk around v: each ring vertex is read once, and a spoke's
+    It is illegal_meshed_edge's test, each predicate given the same points in the
+    same argument order, taken in one walk around v: each ring vertex is read once, and a spoke's
     two triangles are the walk's current and previous ones (their states known), so
     the angles facing it come from the two triangles' own passes."""
     cdef int e0 = T.vhe[v], e = e0

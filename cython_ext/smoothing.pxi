@@ -56,9 +56,9 @@ cdef enum:
 # uniform square; three rounds with them in the last only (and nowhere else) left
 # 1.2 % more, for 8-9 % fewer.
 cdef enum Descent:
-    DESCENT_NONE = 0    # every round tries the neighbours' mean only
-    DESCENT_EVERY = 1   # every round descends (the settling rounds around new points)
-    DESCENT_LAST = 2    # the last round only; every vertex is judged again for it
+    DESCENT_NONE = 0    # no round (but at the vertices next to a bad triangle)
+    DESCENT_EVERY = 1   # every round (the settling rounds around new points)
+    DESCENT_LAST = 2    # the last round, which also judges the vertices that stayed
 
 
 cdef struct Movable:
