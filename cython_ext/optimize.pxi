@@ -262,7 +262,7 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogi
         best = c
         bx = lap[0]
         by = lap[1]
-    descended = descend or worst0 < OPT_DESCEND_BELOW
+    descended = _takes_steps(descend, worst0)
     if descended:
         _descend(&R, L, worst0, &bx, &by, &best)
     if bx == cx and by == cy:
@@ -274,6 +274,12 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogi
         T.xy[2 * v + 1] = cy
         return _stayed(T, v, descended)
     return _legalize_around(T, v) if swaps else 1
+
+
+cdef inline bint _takes_steps(bint descend, double worst0) noexcept nogil:
+    # the gradient steps after the mean: in the rounds that take them, and next to a
+    # triangle shaped worse than OPT_DESCEND_BELOW (worst0) in every round
+    return descend or worst0 < OPT_DESCEND_BELOW
 
 
 cdef inline int _stayed(Tri* T, int v, bint descended) noexcept nogil:

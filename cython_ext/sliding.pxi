@@ -27,8 +27,8 @@
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
 # Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
-# _cost_of_shapes, _better, _settled, _ring_ccw, _stayed, _legalize_around, OPT_SKIP,
-# OPT_DESCEND_BELOW, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP,
+# _cost_of_shapes, _better, _settled, _ring_ccw, _takes_steps, _stayed, _legalize_around,
+# OPT_SKIP, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP,
 # OPT_INVALID);
 # smoothing.pxi (_shape).
 from halfedge cimport *
@@ -174,7 +174,7 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps, bint descend) noe
         bt = t
         bx = x
         by = y
-    descended = descend or worst0 < OPT_DESCEND_BELOW
+    descended = _takes_steps(descend, worst0)
     if descended:
         _descend_on_line(&R, &G, worst0, &bt, &bx, &by, &best)
     if bx == cx and by == cy:
