@@ -157,21 +157,26 @@ cdef int _gather_ring(Tri* T, int v, int e0, Ring* R, double* q) noexcept nogil:
     return n
 
 
-cdef void _laplacian(const Ring* R, const double* pv, double* lap,
-                     double* mean_len) noexcept nogil:
-    """From the gathered ring: lap[0:2] the mean of v's neighbours, and mean_len the
-    mean length of the edges from v (at pv) to them."""
+cdef void _laplacian(const Ring* R, double* lap) noexcept nogil:
+    """From the gathered ring: lap[0:2] the mean of v's neighbours."""
     cdef int i, n = R.n
-    cdef double lsum = 0.0
     lap[0] = 0.0
     lap[1] = 0.0
     for i in range(n):
         lap[0] += R.x[i]
         lap[1] += R.y[i]
-        lsum += sqrt((R.x[i] - pv[0]) ** 2 + (R.y[i] - pv[1]) ** 2)
     lap[0] /= n
     lap[1] /= n
-    mean_len[0] = lsum / n
+
+
+cdef double _mean_length(const Ring* R, const double* pv) noexcept nogil:
+    """The mean length of the edges from v (at pv) to its gathered neighbours: the
+    unit of the gradient steps (only a vertex that takes them needs it)."""
+    cdef int i, n = R.n
+    cdef double lsum = 0.0
+    for i in range(n):
+        lsum += sqrt((R.x[i] - pv[0]) ** 2 + (R.y[i] - pv[1]) ** 2)
+    return lsum / n
 
 
 cdef double _cost_of_shapes(const double* q, int n, double* worst) noexcept nogil:
@@ -243,7 +248,7 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogi
     cdef Ring R
     cdef double lap[2]
     cdef double q[OPT_RING_CAP]
-    cdef double worst0, L, c, best, bx, by
+    cdef double worst0, c, best, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
     cdef bint descended
     if e0 < 0:
@@ -254,7 +259,7 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogi
     best = _cost_of_shapes(q, n, &worst0)
     if worst0 > OPT_SKIP or best >= OPT_INVALID:
         return 0
-    _laplacian(&R, P(T, v), lap, &L)
+    _laplacian(&R, lap)
     bx = cx
     by = cy
     c = _cost_at(&R, lap[0], lap[1], worst0)
@@ -264,7 +269,7 @@ cdef int _optimize_vertex(Tri* T, int v, bint swaps, bint descend) noexcept nogi
         by = lap[1]
     descended = _takes_steps(descend, worst0)
     if descended:
-        _descend(&R, L, worst0, &bx, &by, &best)
+        _descend(&R, _mean_length(&R, P(T, v)), worst0, &bx, &by, &best)
     if bx == cx and by == cy:
         return _stayed(T, v, descended)
     T.xy[2 * v] = bx

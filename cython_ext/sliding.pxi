@@ -26,7 +26,7 @@
 # that gained a mean radius ratio of 2e-5.  So does a point with more than
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
-# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
+# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian, _mean_length,
 # _cost_of_shapes, _better, _settled, _ring_ccw, _takes_steps, _stayed, _legalize_around,
 # OPT_SKIP, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP,
 # OPT_INVALID);
@@ -143,7 +143,7 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps, bint descend) noe
     cdef Line G
     cdef double lap[2]
     cdef double q[OPT_RING_CAP]
-    cdef double worst0, L, c, best, x, y, t, bt, bx, by
+    cdef double worst0, c, best, x, y, t, bt, bx, by
     cdef double cx = T.xy[2 * v], cy = T.xy[2 * v + 1]
     cdef bint descended
     if s == NONE:
@@ -161,8 +161,7 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps, bint descend) noe
     G.L2 = G.dx * G.dx + G.dy * G.dy
     if not G.L2 > 0.0:
         return 0
-    _laplacian(&R, P(T, v), lap, &L)
-    G.step = L / sqrt(G.L2)
+    _laplacian(&R, lap)
     bt = _param(&G, cx, cy)
     bx = cx
     by = cy
@@ -176,6 +175,7 @@ cdef int slide_vertex(Tri* T, int v, int a, int b, bint swaps, bint descend) noe
         by = y
     descended = _takes_steps(descend, worst0)
     if descended:
+        G.step = _mean_length(&R, P(T, v)) / sqrt(G.L2)
         _descend_on_line(&R, &G, worst0, &bt, &bx, &by, &best)
     if bx == cx and by == cy:
         return _stayed(T, v, descended)

@@ -222,16 +222,19 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     if not polygons:
         raise InvalidDomainError("the domain has no polygon to mesh")
     names = [f"polygon {k}" if len(polygons) > 1 else "the polygon" for k in range(len(polygons))]
-    checked = [check_polygon(p, names[k]) for k, p in enumerate(polygons)]
+    # parts that meet at points only (a valid multipolygon, whose parts are then valid
+    # each): their union (an overlay, ten times the cost of this check on real data)
+    # is those parts again, and only its area is used
+    multi = MultiPolygon(polygons) if len(polygons) > 1 and not lines and not points else None
+    parts_valid = multi is not None and bool(shapely.is_valid(multi))
+    checked = [check_polygon(p, names[k], parts_valid) for k, p in enumerate(polygons)]
     # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
     # copy), so it is not computed: check_polygon's validity holds for what is meshed
-    valid = len(polygons) == 1
-    if valid:
+    valid = len(polygons) == 1 or parts_valid
+    if len(polygons) == 1:
         union = polygons[0]
-    elif not lines and not points and shapely.is_valid(multi := MultiPolygon(polygons)):
-        # parts that meet at points only: their union (an overlay, ten times the cost
-        # of this check on real data) is those parts again, and only its area is used
-        union, valid = multi, True
+    elif parts_valid:
+        union = multi
     else:
         union = shapely.union_all(polygons)
     check_lines_inside(polygons, lines, line_names, points, tolerance, union)

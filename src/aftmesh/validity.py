@@ -86,15 +86,17 @@ def _hole_problems(poly: Polygon) -> list[str]:
     return problems
 
 
-def check_polygon(poly: Polygon, where: str) -> tuple[np.ndarray, float]:
+def check_polygon(poly: Polygon, where: str, known_valid: bool = False) -> tuple[np.ndarray, float]:
     """Refuse an empty, non-finite, invalid or zero-area polygon, naming each ring at
     fault (exterior, hole k, holes i and j) and where.  Returns what it looked at: the
-    x, y coordinates (each ring closed, the exterior first) and the area."""
+    x, y coordinates (each ring closed, the exterior first) and the area.
+    `known_valid`: the caller has found it valid already (a valid multipolygon's
+    parts are), so its validity is not computed again."""
     coords = shapely.get_coordinates(poly)
     if len(coords) == 0:  # a polygon is empty exactly when it has no coordinates
         raise InvalidDomainError(f"{where} is empty")
     _check_finite(poly, where, coords)
-    if not poly.is_valid:
+    if not known_valid and not poly.is_valid:
         problems = []
         outer = Polygon(poly.exterior)
         if not outer.is_valid:
