@@ -748,7 +748,7 @@ def test_strategy_that_stops_early_is_an_error():
     "option",
     [
         {"greedy": 0},  # equals False, but a flag must be a bool
-        {"smooth": 3.0},  # equals the default 3, but rounds are an integer
+        {"smooth": 4.0},  # equals the default 4, but rounds are an integer
         {"order": "Shortest"},
         {"min_angle": 40.0},
     ],
@@ -756,7 +756,7 @@ def test_strategy_that_stops_early_is_an_error():
 )
 def test_options_equal_to_a_default_are_still_checked(option):
     """generate skips check_options only for the default objects themselves, so a
-    value that compares equal to a default (0 == False, 3.0 == 3) is still refused,
+    value that compares equal to a default (0 == False, 4.0 == 4) is still refused,
     as is any other bad value given."""
     with pytest.raises(aftmesh.InvalidOptionError):
         aftmesh.generate(dc.square().domain, 0.5, **option)

@@ -7,13 +7,15 @@ and y are 1-D arrays of equal length, the result one size per point or a scalar)
 
 Whatever it is, it is combined with what the boundary asks for (an input edge shorter
 than the size keeps its length as the size at its ends; with split_boundary=False, where
-two edges meet at a wide angle, the geometric mean of theirs) and gradation-limited, so that
-the size never grows faster than ``gradation`` per unit of length relative to itself
-(h(x) <= h(y) + (gradation - 1) |x - y|).  The result is a constant, or sizes at the
-vertices of a background Delaunay triangulation of the input vertices (plus the points
-where a callable needed more samples), read by the kernel as cython_ext/sizing.pxi
-says.  So the field costs what the input costs, never what its bounding box spans:
-a long thin domain or a tiny edge does not make it bigger.
+two edges meet at a wide angle, the geometric mean of theirs) and gradation-limited, so
+that the size grows no faster than ``gradation`` per unit of length relative to itself
+(h(x) <= h(y) + (gradation - 1) |x - y|) along the background's edges and around each of
+its vertices (across a long background triangle next to much smaller sizes it can grow
+faster: cython_ext/sizing.pxi says where and by how much).  The result is a constant, or
+sizes at the vertices of a background Delaunay triangulation of the input vertices (plus
+the points where a callable needed more samples), read by the kernel as
+cython_ext/sizing.pxi says.  So the field costs what the input costs, never what its
+bounding box spans: a long thin domain or a tiny edge does not make it bigger.
 """
 
 from __future__ import annotations
