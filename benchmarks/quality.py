@@ -2,8 +2,9 @@
 or ``python -m benchmarks.quality --bands CASE [CASE ...] [--mesher NAME ...]``
 
 Labels each triangle of aftmesh's mesh of a benchmark case whose radius ratio is below
-the threshold by where it came from (:func:`aftmesh.diagnose.diagnose`: smoothing,
-boundary, size transition, front collision, other), prints the counts per class and
+the threshold by where it came from (:func:`aftmesh.diagnose.diagnose`: an input
+angle too narrow for any better triangle, smoothing, boundary, size transition, front
+collision, other), prints the counts per class and
 draws the bad triangles coloured by class.  CASE is any benchmark case name (see
 ``python -m benchmarks --list``), including the real-world group's ``rw-*``.
 
@@ -27,6 +28,7 @@ from . import runner
 from .cases import build_case
 
 COLOURS = {
+    "input_angle": "tab:green",
     "smoothing": "tab:purple",
     "boundary": "tab:blue",
     "size": "tab:orange",

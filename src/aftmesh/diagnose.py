@@ -4,6 +4,11 @@
 smoothing (recording every step) and once as asked, and labels each triangle of the
 final mesh whose radius ratio is below a threshold with the first class that applies:
 
+``input_angle``
+    it lies in a wedge between input segments at one vertex that is narrower than the
+    smallest angle a triangle of radius ratio ``threshold`` can have (40 degrees at
+    0.9; see :func:`smallest_angle`): no triangle there can be better, whatever the
+    mesher does.  Exact up to the rounding of the angles.
 ``smoothing``
     no triangle around any of its vertices was bad before smoothing: the badness
     appeared when vertices moved (or edges were swapped after the moves).
@@ -46,12 +51,13 @@ from .aft import Strategy
 from .generate import generate
 from .mesh import Mesh, triangle_quality
 
-__all__ = ["CLASSES", "Diagnosis", "diagnose"]
+__all__ = ["CLASSES", "Diagnosis", "diagnose", "smallest_angle"]
 
-CLASSES = ("smoothing", "boundary", "size", "collision", "other")
+CLASSES = ("input_angle", "smoothing", "boundary", "size", "collision", "other")
 SIZE_RATIO = 1.3  # size field max / min over one triangle: a transition
 NEIGHBOUR_RATIO = 1.5  # mean edge length of a triangle against a neighbour's
 OPPOSING_DEGREES = 120.0  # front normals this far apart came from opposite sides
+SMALLEST_ANGLE_BISECTIONS = 60  # halvings of 60 degrees: below a double's resolution
 
 
 class _Recorder(Strategy):
@@ -107,8 +113,83 @@ class Diagnosis:
         lines = [f"{len(self.bad)} of {n} triangles have RR < {self.threshold:g} ({share:.2f} %)"]
         for c in CLASSES:
             k = self.counts.get(c, 0)
-            lines.append(f"  {c:10s} {k:7d}  {100 * k / max(len(self.bad), 1):5.1f} %")
+            lines.append(f"  {c:11s} {k:7d}  {100 * k / max(len(self.bad), 1):5.1f} %")
         return "\n".join(lines)
+
+
+def smallest_angle(threshold: float) -> float:
+    """The smallest angle, in degrees, of a triangle whose radius ratio is at least
+    `threshold`: for a given smallest angle a the isosceles triangle is the roundest,
+    of radius ratio 8 sin(a / 2) sin((pi - a) / 4)^2, which grows with a up to 1 at
+    60 degrees (solved here by bisection).
+
+    >>> round(smallest_angle(0.9), 1)
+    40.0
+    >>> smallest_angle(1.0), smallest_angle(0.0)
+    (60.0, 0.0)
+    """
+    if threshold >= 1.0:
+        return 60.0
+    if threshold <= 0.0:
+        return 0.0
+    lo, hi = 0.0, math.pi / 3
+    for _ in range(SMALLEST_ANGLE_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        if 8 * math.sin(mid / 2) * math.sin((math.pi - mid) / 4) ** 2 < threshold:
+            lo = mid
+        else:
+            hi = mid
+    return math.degrees(lo)
+
+
+def _corner_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
+    """(t, 3): the angle of each triangle at each of its corners, in radians."""
+    p = points[tris]
+    out = np.empty(tris.shape)
+    for k in range(3):
+        u = p[:, (k + 1) % 3] - p[:, k]
+        w = p[:, (k + 2) % 3] - p[:, k]
+        out[:, k] = np.arctan2(np.abs(u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]), (u * w).sum(1))
+    return out
+
+
+def _across(mesh: Mesh) -> np.ndarray:
+    """(t, 3, 2): for the corner k of triangle i at v, the corners at v of the two
+    triangles across its edges at v (-1 across a segment or the outside)."""
+    t, nb, n = mesh.triangles, mesh.neighbors, len(mesh.points)
+    seg = np.sort(mesh.segments, axis=1).astype(np.int64)
+    seg_keys = seg[:, 0] * n + seg[:, 1]
+    out = np.full(t.shape + (2,), -1, dtype=np.int64)
+    for k in range(3):
+        v = t[:, k]
+        for j, side in enumerate(((k + 1) % 3, (k + 2) % 3)):
+            # the edge opposite corner `side` runs from v to the third corner
+            other = t[:, 3 - k - side]
+            key = np.minimum(v, other).astype(np.int64) * n + np.maximum(v, other)
+            j_tri = nb[:, side]
+            open_ = (j_tri >= 0) & ~np.isin(key, seg_keys)
+            rows = np.flatnonzero(open_)
+            pos = np.argmax(t[j_tri[rows]] == v[rows, None], axis=1)
+            out[rows, k, j] = 3 * j_tri[rows] + pos
+    return out
+
+
+def _narrow_wedge(mesh: Mesh, threshold: float) -> np.ndarray:
+    """Per triangle: does one of its corners lie in a wedge (the corners at one vertex
+    between two segments, joined across the edges that are not) whose angle is below
+    smallest_angle(threshold)?  A wedge around an inner vertex is a full turn."""
+    angle = _corner_angles(mesh.points, mesh.triangles).ravel()
+    across = _across(mesh).reshape(-1, 2)
+    label = np.arange(len(angle))
+    while True:  # each corner takes the least label of its wedge, a step at a time
+        seen = np.where(across >= 0, label[np.maximum(across, 0)], len(label))
+        new = np.minimum(label, seen.min(axis=1))
+        if np.array_equal(new, label):
+            break
+        label = new
+    wedge = np.bincount(label, weights=angle, minlength=len(label))
+    narrow = wedge[label] < math.radians(smallest_angle(threshold))
+    return np.asarray(narrow.reshape(-1, 3).any(axis=1))
 
 
 def _vertex_index(points: np.ndarray) -> dict:
@@ -187,6 +268,7 @@ def diagnose(
     on_segment[mesh.segments.ravel()] = True
     t = mesh.triangles[bad]
     tests = {
+        "input_angle": _narrow_wedge(mesh, threshold)[bad],
         "smoothing": ~was_bad[t].any(axis=1),
         "boundary": on_segment[t].any(axis=1),
         "size": _size_transition(mesh, q)[bad],
