@@ -4,9 +4,9 @@ or ``python -m benchmarks.quality --bands CASE [CASE ...] [--mesher NAME ...]``
 Labels each triangle of aftmesh's mesh of a benchmark case whose radius ratio is below
 the threshold by where it came from (:func:`aftmesh.diagnose.diagnose`: an input
 angle too narrow for any better triangle, smoothing, boundary, size transition, front
-collision, other), prints the counts per class and
-draws the bad triangles coloured by class.  CASE is any benchmark case name (see
-``python -m benchmarks --list``), including the real-world group's ``rw-*``.
+collision, other), prints the counts per class and draws the bad triangles coloured by
+class.  CASE is any benchmark case name (see ``python -m benchmarks --list``),
+including the real-world group's ``rw-*``.
 
 ``--bands`` instead compares meshers band by band of distance from the input edges (in
 target sizes): triangles, mean radius ratio, the count at or below the threshold, the

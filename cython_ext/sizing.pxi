@@ -27,7 +27,8 @@
 # 4.5 times).  Reading every cone instead made the real-world group 2.7 % more
 # triangles for a mean radius ratio 0.0003 higher and 1.6 % fewer of radius ratio
 # <= 0.9 (the detailed coasts gained, up to 0.002; funny and archipelago fell below
-# 97 % above 0.9), at the cost of a look-up per background vertex.
+# 97 % above 0.9); that experiment evaluated every background vertex's cone at every
+# look-up, and an exact field at a bounded cost would need a search structure.
 #
 # Uses: sizing.pxd (SizeField); nothing else of the kernel.
 
