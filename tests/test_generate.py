@@ -904,6 +904,32 @@ def test_rows_from_a_small_hole_meet_the_first_row_of_a_straight_side(checked, g
     assert rr.mean() > 0.977
 
 
+def _staircase(steps: int, step: float) -> Polygon:
+    # a right triangle's hypotenuse made a staircase: 90 and 270 degree input corners
+    pts = [(0.0, 0.0), (steps * step, 0.0)]
+    x, y = steps * step, 0.0
+    for _ in range(steps):
+        y += step
+        pts.append((x, y))
+        x -= step
+        pts.append((x, y))
+    return Polygon(pts)
+
+
+@pytest.mark.parametrize(("steps", "step", "h"), [(20, 0.5, 1.0), (12, 1.0, 1.3)])
+def test_wide_input_corners_are_shared_by_two_triangles(checked, steps, step, h):
+    """A staircase (a pixelated outline, as rw-earcut-rain's): where the unmeshed
+    triangle on an input edge filled a 90 degree corner alone, the corner got one
+    right triangle (radius ratio 0.83), 54 and 29 triangles of radius ratio <= 0.9
+    here; with R on the corner's bisector (front.pxi's _split_wide_corner) two halves
+    share it: 24 and 25, mean radius ratio 0.938 -> 0.954 and 0.939 -> 0.951."""
+    domain = _staircase(steps, step)
+    mesh = checked(aftmesh.generate(domain, h), domain_area=domain.area)
+    rr = triangle_quality(mesh.points, mesh.triangles)["radius_ratio"]
+    assert (rr <= 0.9).sum() <= 27
+    assert rr.mean() > 0.948
+
+
 @settings(max_examples=25)
 @given(domain=dc.curved_domains())
 def test_random_curved_domains_snapping_to_the_lattice_stay_valid(domain):
