@@ -476,11 +476,11 @@ cdef double PROXIMITY_REACH_MAX = 0.95
 # corner's bisector (_split_wide_corner).  From about 81.5 degrees two isosceles
 # halves are rounder than one triangle over the whole corner (radius ratio 0.908
 # each); a single triangle on a 90 degree corner is a right one (0.83).  On the
-# real-world group (bisector points at the geometric mean of the edges' lengths,
-# before the ratio below) 79 / 83 / 87 degrees left 43,213 / 43,063 / 43,115
-# triangles of radius ratio <= 0.9 (44,332 without the rule), and an upper end of
-# 120 / 150 / 175 degrees 43,174 / 43,063 / 43,116: beyond it the front's own rows
-# share the corner out.
+# real-world group, with the bisector point at the geometric mean of the edges'
+# lengths and no ratio limit (below), 79 / 83 / 87 degrees left 43,213 / 43,063 /
+# 43,115 triangles of radius ratio <= 0.9 (44,332 without the rule), and an upper
+# end of 120 / 150 / 175 degrees 43,174 / 43,063 / 43,116: beyond it the front's own
+# rows share the corner out.  At the arithmetic mean (used) it left 43,044.
 cdef double CORNER_SPLIT_MIN = 83.0 * 3.141592653589793 / 180.0
 cdef double CORNER_SPLIT_MAX = 150.0 * 3.141592653589793 / 180.0
 # ... when the corner's two edges differ in length by at most this factor: between
