@@ -16,10 +16,11 @@
 #
 # Uses: halfedge.pxd; aft.pxd (Aft, QueueItem); sizing.pxi (size_at); lattice.pxi;
 # predicates.pxi; triangulation.pxi (find_edge, insert_vertex_at, add_vertex,
-# legalize_meshed, reserve_stack, _grow); cdt.pxi (insert_segment).
+# legalize_meshed, reserve_stack, _grow); cdt.pxi (insert_segment); valence.pxi
+# (_angle_at).
 from halfedge cimport *
 from aft cimport Aft, QueueItem
-from libc.math cimport sqrt, floor, log2, fabs, atan2
+from libc.math cimport sqrt, floor, log2, fabs
 from libc.stdlib cimport malloc, free
 from libc.string cimport memset, memcpy
 from libc.stdint cimport uint64_t
@@ -515,7 +516,7 @@ cdef void _split_wide_corner(Aft* A, Tri* T, int e, double* R) noexcept nogil:
     lw = sqrt(wx * wx + wy * wy)
     if not (lu > 0.0 and lw > 0.0) or lu > CORNER_SPLIT_RATIO * lw or lw > CORNER_SPLIT_RATIO * lu:
         return
-    angle = atan2(fabs(ux * wy - uy * wx), ux * wx + uy * wy)
+    angle = _angle_at(P(T, c), P(T, u), P(T, S))
     if angle < CORNER_SPLIT_MIN or angle > CORNER_SPLIT_MAX:
         return
     bx = ux / lu + wx / lw

@@ -336,9 +336,9 @@ cdef bint _ring_needs_flips(Tri* T, int v) noexcept nogil:
     mesh, are exactly those of the stack run alone.
 
     It is illegal_meshed_edge's test, each predicate given the same points in the
-    same argument order, taken in one walk around v: each ring vertex is read once, and a spoke's
-    two triangles are the walk's current and previous ones (their states known), so
-    the angles facing it come from the two triangles' own passes."""
+    same argument order, taken in one walk around v: each ring vertex is read once,
+    and a spoke's two triangles are the walk's current and previous ones (their
+    states known), so the angles facing it come from the two triangles' own passes."""
     cdef int e0 = T.vhe[v], e = e0
     cdef double* pv = P(T, v)
     cdef double* pu

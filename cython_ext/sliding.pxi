@@ -26,10 +26,10 @@
 # that gained a mean radius ratio of 2e-5.  So does a point with more than
 # OPT_RING_CAP triangles around it (so that _legalize_around reaches all of them).
 #
-# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian, _mean_length,
-# _cost_of_shapes, _better, _settled, _ring_ccw, _takes_steps, _stayed, _legalize_around,
-# OPT_SKIP, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS, OPT_RING_CAP,
-# OPT_INVALID);
+# Uses: halfedge.pxd; optimize.pxi (Ring, _cost_at, _cost_gradient, _laplacian,
+# _mean_length, _cost_of_shapes, _better, _settled, _ring_ccw, _takes_steps, _stayed,
+# _legalize_around, OPT_SKIP, OPT_DESCENT, OPT_DESCENT_LENGTHS, OPT_DESCENT_STEPS,
+# OPT_RING_CAP, OPT_INVALID);
 # smoothing.pxi (_shape).
 from halfedge cimport *
 from libc.math cimport sqrt, INFINITY

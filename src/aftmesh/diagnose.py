@@ -142,17 +142,6 @@ def smallest_angle(threshold: float) -> float:
     return math.degrees(lo)
 
 
-def _corner_angles(points: np.ndarray, tris: np.ndarray) -> np.ndarray:
-    """(t, 3): the angle of each triangle at each of its corners, in radians."""
-    p = points[tris]
-    out = np.empty(tris.shape)
-    for k in range(3):
-        u = p[:, (k + 1) % 3] - p[:, k]
-        w = p[:, (k + 2) % 3] - p[:, k]
-        out[:, k] = np.arctan2(np.abs(u[:, 0] * w[:, 1] - u[:, 1] * w[:, 0]), (u * w).sum(1))
-    return out
-
-
 def _across(mesh: Mesh) -> np.ndarray:
     """(t, 3, 2): for the corner k of triangle i at v, the corners at v of the two
     triangles across its edges at v (-1 across a segment or the outside)."""
@@ -174,11 +163,12 @@ def _across(mesh: Mesh) -> np.ndarray:
     return out
 
 
-def _narrow_wedge(mesh: Mesh, threshold: float) -> np.ndarray:
+def _narrow_wedge(mesh: Mesh, threshold: float, angles: np.ndarray) -> np.ndarray:
     """Per triangle: does one of its corners lie in a wedge (the corners at one vertex
     between two segments, joined across the edges that are not) whose angle is below
-    smallest_angle(threshold)?  A wedge around an inner vertex is a full turn."""
-    angle = _corner_angles(mesh.points, mesh.triangles).ravel()
+    smallest_angle(threshold)?  A wedge around an inner vertex is a full turn.
+    `angles`: triangle_quality's, in degrees."""
+    angle = angles.ravel()
     across = _across(mesh).reshape(-1, 2)
     label = np.arange(len(angle))
     while True:  # each corner takes the least label of its wedge, a step at a time
@@ -188,7 +178,7 @@ def _narrow_wedge(mesh: Mesh, threshold: float) -> np.ndarray:
             break
         label = new
     wedge = np.bincount(label, weights=angle, minlength=len(label))
-    narrow = wedge[label] < math.radians(smallest_angle(threshold))
+    narrow = wedge[label] < smallest_angle(threshold)
     return np.asarray(narrow.reshape(-1, 3).any(axis=1))
 
 
@@ -268,7 +258,7 @@ def diagnose(
     on_segment[mesh.segments.ravel()] = True
     t = mesh.triangles[bad]
     tests = {
-        "input_angle": _narrow_wedge(mesh, threshold)[bad],
+        "input_angle": _narrow_wedge(mesh, threshold, q["angles"])[bad],
         "smoothing": ~was_bad[t].any(axis=1),
         "boundary": on_segment[t].any(axis=1),
         "size": _size_transition(mesh, q)[bad],

@@ -14,7 +14,8 @@ def triangle_quality(points: np.ndarray, triangles: np.ndarray) -> dict[str, np.
 
     Returns a dict of arrays: ``radius_ratio`` (2 r_in / r_circ: 1 for an equilateral
     triangle, 0 for a degenerate one), ``min_angle`` and ``max_angle`` in degrees,
-    ``area``, and ``edge_lengths`` (t, 3) with column k the edge opposite vertex k.
+    ``angles`` (t, 3) in degrees with column k the angle at vertex k, ``area``, and
+    ``edge_lengths`` (t, 3) with column k the edge opposite vertex k.
     """
     p = points[triangles]
     e = np.stack([p[:, 2] - p[:, 1], p[:, 0] - p[:, 2], p[:, 1] - p[:, 0]], axis=1)
@@ -38,6 +39,7 @@ def triangle_quality(points: np.ndarray, triangles: np.ndarray) -> dict[str, np.
         radius_ratio=rr,
         min_angle=ang.min(axis=1),
         max_angle=ang.max(axis=1),
+        angles=ang,
         area=area,
         edge_lengths=lengths,
     )
