@@ -335,20 +335,28 @@ cdef class Triangulation:
             raise
         return merged_arr, n_merged, through
 
-    def add_points(self, const double[:, ::1] points):
+    def add_points(self, const double[:, ::1] points, const int32_t[::1] near=None):
         """Append points as new vertices and insert them into the triangulation (which
-        must have been started by insert_points).  Returns their vertex indices, or
-        the earlier vertex at exactly the same place."""
-        cdef int m = points.shape[0], i, v, res = 0
+        must have been started by insert_points).  near (optional, one vertex per
+        point) starts each point's walk at a triangle of that vertex: a point close to
+        it is then found in a few steps (where it lands does not depend on the walk).
+        Returns their vertex indices, or the earlier vertex at exactly the same
+        place."""
+        cdef int m = points.shape[0], i, v, res = 0, start = NONE
+        cdef bint hinted = near is not None
+        if hinted and near.shape[0] != m:
+            raise ValueError(f"near needs one vertex per point ({m}), got {near.shape[0]}")
         out_arr = np.empty(m, dtype=np.int32)
         cdef int32_t[::1] out = out_arr
         with nogil:
             for i in range(m):
+                if hinted and 0 <= near[i] < self.T.nv and self.T.vhe[near[i]] >= 0:
+                    start = tri_of(self.T.vhe[near[i]])
                 v = add_vertex(&self.T, points[i, 0], points[i, 1])
                 if v < 0:
                     res = v
                     break
-                res = insert_vertex(&self.T, v, NONE)
+                res = insert_vertex(&self.T, v, start)
                 if res < 0:
                     break
                 out[i] = res

@@ -293,9 +293,12 @@ def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
         )  # fmt: skip
         if len(at) == 0:
             break
-        at = at[brio_order(mid[at])]  # short walks between consecutive insertions
+        # spatial order: fewer flips than the order of the edges (and the background
+        # it gives decides the ties between cocircular points)
+        at = at[brio_order(mid[at])]
         new = np.ascontiguousarray(mid[at])
-        tri.add_points(new)
+        # each midpoint's walk starts at its edge's first end, a few triangles away
+        tri.add_points(new, np.ascontiguousarray(ends[at, 0], dtype=np.int32))
         pts = np.concatenate([pts, new])
         u = np.concatenate([u, um[at]])
     return pts, u
