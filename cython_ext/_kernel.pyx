@@ -67,6 +67,7 @@ include "chains.pxi"
 include "sliding.pxi"
 include "inputs.pxi"
 include "nearby.pxi"
+include "crossings.pxi"
 include "discretize.pxi"
 include "background.pxi"
 include "resolve.pxi"
@@ -1176,6 +1177,19 @@ def rings_proper(const double[:, ::1] xy, const int64_t[:, ::1] seg):
     if m == 0:
         return True
     return rings_are_proper(&xy[0, 0], n, &seg[0, 0], m) == 1
+
+
+def segments_cross(const double[:, ::1] xy, const int64_t[:, ::1] seg):
+    """1 if two segments cross at a point inside both, 0 if none do, -1 when the grid
+    test gave up (see crossings.pxi): a proof of no crossing without a CDT."""
+    cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0]
+    cdef int res
+    _check_pslg(xy, seg)
+    if m < 2:
+        return 0
+    with nogil:
+        res = any_crossing(&xy[0, 0], n, &seg[0, 0], m)
+    return res
 
 
 def vertices_near_segments_pairs(const double[:, ::1] xy, const int64_t[:, ::1] seg,

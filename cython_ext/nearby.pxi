@@ -1,6 +1,7 @@
 # Which vertices lie near which segments: the candidate search of noding.py's
 # split_at_vertices (a ring touching another at a vertex, a constraint line ending on a
-# boundary), by a uniform grid over the points' bounding box.
+# boundary), by a uniform grid over the points' bounding box (crossings.pxi tests the
+# pairs of segments in each of its cells too).
 #
 # The grid has about as many cells as there are segments, so its cost follows the
 # input, never the box's extent; each segment is registered in the cells its box

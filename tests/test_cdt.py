@@ -1151,6 +1151,71 @@ def small_segment_graphs(draw):
     return V, S
 
 
+def _proper_pairs(V, S):
+    """Pairs whose four orientations are non-zero and opposite in pairs (rationals):
+    what the kernel's grid test looks for, a crossing at an input vertex included."""
+    X = _fractions(V)
+    out = set()
+    for i in range(len(S)):
+        for j in range(i + 1, len(S)):
+            a, b = X[S[i][0]], X[S[i][1]]
+            c, d = X[S[j][0]], X[S[j][1]]
+            if (
+                _orient_exact(a, b, c) * _orient_exact(a, b, d) < 0
+                and _orient_exact(c, d, a) * _orient_exact(c, d, b) < 0
+            ):
+                out.add((i, j))
+    return out
+
+
+def _grid_says(V, S):
+    return _kernel.segments_cross(
+        np.asarray(V, dtype=np.float64), np.asarray(S, dtype=np.int64).reshape(-1, 2)
+    )
+
+
+@given(small_segment_graphs())
+def test_grid_crossing_test_is_exact(graph):
+    """The grid test that spares a dict its CDT (crossings.pxi) answers 1 exactly when
+    two segments cross (every crossing the CDT would refuse among them), else 0."""
+    V, S = graph
+    assert _grid_says(V, S) == (1 if _proper_pairs(V, S) else 0)
+    if _grid_says(V, S) == 0:
+        assert not crossing_pairs(V, S)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_grid_crossing_test_finds_a_crossing_among_many_segments(seed):
+    """Hundreds of short segments over a grid of many cells, with and without one
+    crossing pair among them: the crossing is found wherever it is."""
+    rng = np.random.default_rng(seed)
+    n = 300
+    start = rng.uniform(0, 10, (n, 2))
+    ang = rng.uniform(0, np.pi, n)
+    end = start + 0.05 * np.c_[np.cos(ang), np.sin(ang)]
+    V = np.r_[start, end]
+    S = np.c_[np.arange(n), np.arange(n) + n]
+    expected = _proper_pairs(V.tolist(), S.tolist())
+    assert _grid_says(V, S) == (1 if expected else 0)
+    k = int(rng.integers(n))  # a segment across segment k's middle, at right angles
+    mid, d = 0.5 * (V[k] + V[k + n]), V[k + n] - V[k]
+    V2 = np.r_[V, [mid - 0.3 * d[::-1] * [1, -1], mid + 0.3 * d[::-1] * [1, -1]]]
+    S2 = np.r_[S, [[2 * n, 2 * n + 1]]]
+    assert _grid_says(V2, S2) == 1
+
+
+def test_crossing_in_a_crowded_cell_is_still_refused():
+    """A fan of segments from one vertex fills one grid cell, the grid test gives up
+    (-1), and the CDT decides: the crossing added to the fan is refused as before."""
+    ang = np.linspace(0, np.pi / 2, 400)
+    V = np.r_[[[0.0, 0.0]], np.c_[np.cos(ang), np.sin(ang)], [[0.2, -0.1], [0.2, 0.5]]]
+    S = np.r_[np.c_[np.zeros(400, dtype=int), np.arange(1, 401)], [[401, 402]]]
+    assert _grid_says(V, S) == -1
+    ring = [[401, 1], [1, 400], [400, 0], [0, 401]]  # any closed ring: a domain
+    with pytest.raises(CrossingSegmentsError):
+        aftmesh.generate({"vertices": V, "segments": np.r_[S, ring]}, 0.5)
+
+
 @given(small_segment_graphs())
 def test_fuzz_crossings_splits_and_overlaps(graph):
     """With the convex hull added as segments (so nothing is carved): a crossing is

@@ -665,6 +665,29 @@ def test_crossing_segments_named():
     assert "segments[0]" in str(err.value) and "segments[1]" in str(err.value)
 
 
+@pytest.mark.parametrize("split_boundary", [True, False])
+@pytest.mark.parametrize(
+    "inner",
+    [
+        [(-1, 0), (1, 0), (0, -1), (0, 1)],  # both halved exactly at the crossing
+        [(-1, 0), (1, 0), (0, -1), (0, 0.5)],  # one runs through the other's midpoint
+        [(-1, 0.1), (1, -0.1), (0.3, -1), (-0.2, 1)],  # a plain crossing
+    ],
+)
+def test_dict_crossings_are_refused_even_where_split_points_hide_them(inner, split_boundary):
+    """A dict's crossing segments are refused, checked before the size splits them:
+    split at size 1, the first two inner pairs meet at a split point, where their
+    pieces no longer cross, and the boundary CDT would node them without a word."""
+    d = dict(
+        vertices=[(-2, -2), (2, -2), (2, 2), (-2, 2), *inner],
+        segments=[(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (6, 7)],
+    )
+    for size in (1.0, 0.3):
+        with pytest.raises(aftmesh.CrossingSegmentsError) as err:
+            aftmesh.generate(d, size, split_boundary=split_boundary)
+        assert set(err.value.segments) == {4, 5}, str(err.value)
+
+
 def test_dict_sources_are_named_by_position_without_a_string_each():
     """A dict's sources are its segments, named ``segments[i]``: info["sources"]
     reads like that list (index, slice, equality, numpy, pickle) but holds no string

@@ -20,6 +20,7 @@ from ._kernel import (
     Triangulation,
     py_orient2d,
     rings_proper,
+    segments_cross,
     unique_points,
     vertices_near_segments_pairs,
 )
@@ -374,10 +375,12 @@ def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
     """Dict / .poly input: segments crossing at a point inside both are refused (the
     policy of aftmesh.cdt), before any size-dependent splitting could hide them.
 
-    The kernel finds them: the Delaunay triangulation of the points, then the
-    segments inserted one by one as constrained edges (exact predicates; a segment
-    running through a vertex is split there, which is no crossing)."""
-    if len(seg) < 2:
+    The kernel finds them: a grid test of the pairs of nearby segments proves most
+    inputs free of any (exact orientations), and otherwise the Delaunay triangulation
+    of the points, then the segments inserted one by one as constrained edges (a
+    segment running through a vertex is split there, which is no crossing), names the
+    first."""
+    if len(seg) < 2 or segments_cross(pts, np.asarray(seg, dtype=np.int64)) == 0:
         return
     kernel = Triangulation(pts)
     try:
