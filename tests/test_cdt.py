@@ -1018,6 +1018,23 @@ def _on_closed_segment(a, b, p):
     )
 
 
+def _proper_pairs(V, S):
+    """Pairs whose four orientations are non-zero and opposite in pairs (rationals):
+    what the kernel's grid test looks for, a crossing at an input vertex included."""
+    X = _fractions(V)
+    out = set()
+    for i in range(len(S)):
+        for j in range(i + 1, len(S)):
+            a, b = X[S[i][0]], X[S[i][1]]
+            c, d = X[S[j][0]], X[S[j][1]]
+            if (
+                _orient_exact(a, b, c) * _orient_exact(a, b, d) < 0
+                and _orient_exact(c, d, a) * _orient_exact(c, d, b) < 0
+            ):
+                out.add((i, j))
+    return out
+
+
 def crossing_pairs(V, S):
     """Pairs of input segments whose interiors cross at a point that is not an input
     vertex (decided in rational arithmetic): the pairs that must raise
@@ -1025,17 +1042,13 @@ def crossing_pairs(V, S):
     X = _fractions(V)
     verts = set(X)
     out = set()
-    for i in range(len(S)):
-        for j in range(i + 1, len(S)):
-            a, b = X[S[i][0]], X[S[i][1]]
-            c, d = X[S[j][0]], X[S[j][1]]
-            o1, o2 = _orient_exact(a, b, c), _orient_exact(a, b, d)
-            o3, o4 = _orient_exact(c, d, a), _orient_exact(c, d, b)
-            if o1 * o2 < 0 and o3 * o4 < 0:
-                t = o3 / (o3 - o4)
-                x = (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
-                if x not in verts:
-                    out.add((i, j))
+    for i, j in _proper_pairs(V, S):
+        a, b = X[S[i][0]], X[S[i][1]]
+        c, d = X[S[j][0]], X[S[j][1]]
+        o3, o4 = _orient_exact(c, d, a), _orient_exact(c, d, b)
+        t = o3 / (o3 - o4)
+        if (a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])) not in verts:
+            out.add((i, j))
     return out
 
 
@@ -1149,23 +1162,6 @@ def small_segment_graphs(draw):
     idx = st.integers(0, len(V) - 1)
     S = draw(st.lists(st.tuples(idx, idx).filter(lambda s: s[0] != s[1]), min_size=1, max_size=10))
     return V, S
-
-
-def _proper_pairs(V, S):
-    """Pairs whose four orientations are non-zero and opposite in pairs (rationals):
-    what the kernel's grid test looks for, a crossing at an input vertex included."""
-    X = _fractions(V)
-    out = set()
-    for i in range(len(S)):
-        for j in range(i + 1, len(S)):
-            a, b = X[S[i][0]], X[S[i][1]]
-            c, d = X[S[j][0]], X[S[j][1]]
-            if (
-                _orient_exact(a, b, c) * _orient_exact(a, b, d) < 0
-                and _orient_exact(c, d, a) * _orient_exact(c, d, b) < 0
-            ):
-                out.add((i, j))
-    return out
 
 
 def _grid_says(V, S):
