@@ -380,8 +380,11 @@ def refuse_crossings(pts: np.ndarray, seg: np.ndarray) -> None:
     of the points, then the segments inserted one by one as constrained edges (a
     segment running through a vertex is split there, which is no crossing), names the
     first."""
-    if len(seg) < 2 or segments_cross(pts, np.asarray(seg, dtype=np.int64)) == 0:
+    if len(seg) < 2:
         return
+    xy = np.ascontiguousarray(pts, dtype=np.float64)
+    if segments_cross(xy, np.ascontiguousarray(seg, dtype=np.int64)) == 0:
+        return  # proved free of crossings, without a CDT
     kernel = Triangulation(pts)
     try:
         merged = kernel.insert_points(brio_order(pts))
