@@ -351,6 +351,7 @@ cdef class Triangulation:
         cdef int32_t[::1] out = out_arr
         with nogil:
             for i in range(m):
+                start = NONE        # the walk's default start, unless near names one
                 if hinted and 0 <= near[i] < self.T.nv and self.T.vhe[near[i]] >= 0:
                     start = tri_of(self.T.vhe[near[i]])
                 v = add_vertex(&self.T, points[i, 0], points[i, 1])
@@ -1185,8 +1186,8 @@ def segments_cross(const double[:, ::1] xy, const int64_t[:, ::1] seg):
     cdef Py_ssize_t n = xy.shape[0], m = seg.shape[0]
     cdef int res
     _check_pslg(xy, seg)
-    if m < 2:
-        return 0
+    if m == 0:
+        return 0            # no segment to point into
     with nogil:
         res = any_crossing(&xy[0, 0], n, &seg[0, 0], m)
     return res

@@ -38,37 +38,35 @@ cdef inline bint _segments_cross(const double* xy, const int64_t* seg, int64_t k
     return o1 != 0 and o2 != 0 and o1 != o2
 
 
+cdef int _cells_cross(const _Grid* G, const double* xy, const int64_t* seg,
+                      int64_t cap) noexcept nogil:
+    """any_crossing's search over the cells of G: 1, 0, or -1 past cap pair tests."""
+    cdef Py_ssize_t c, i, j
+    cdef int64_t tests = 0
+    for c in range(G.g * G.g):
+        for i in range(G.start[c], G.start[c + 1]):
+            for j in range(i + 1, G.start[c + 1]):
+                tests += 1
+                if tests > cap:
+                    return -1
+                if _segments_cross(xy, seg, G.item[i], G.item[j]):
+                    return 1
+    return 0
+
+
 cdef int any_crossing(const double* xy, Py_ssize_t n, const int64_t* seg,
                       Py_ssize_t m) noexcept nogil:
     """1 if two segments cross (see the top of this file), 0 if none do, -1 when the
     test gave up (out of memory, or more than CROSSING_PAIRS_PER_SEGMENT pair tests
     per segment)."""
     cdef _Grid G
-    cdef Py_ssize_t c, i, j
-    cdef int64_t tests = 0, cap = CROSSING_PAIRS_PER_SEGMENT * m
-    cdef int res = 0
-    G.start = NULL
-    G.item = NULL
+    cdef int res = -1
     if m < 2:
         return 0
-    if _grid_build(xy, n, seg, m, 0.0, &G):
-        free(G.start)
-        free(G.item)
-        return -1
-    for c in range(G.g * G.g):
-        for i in range(G.start[c], G.start[c + 1]):
-            for j in range(i + 1, G.start[c + 1]):
-                tests += 1
-                if tests > cap:
-                    res = -1
-                    break
-                if _segments_cross(xy, seg, G.item[i], G.item[j]):
-                    res = 1
-                    break
-            if res != 0:
-                break
-        if res != 0:
-            break
+    G.start = NULL
+    G.item = NULL
+    if _grid_build(xy, n, seg, m, 0.0, &G) == 0:
+        res = _cells_cross(&G, xy, seg, CROSSING_PAIRS_PER_SEGMENT * m)
     free(G.start)
     free(G.item)
     return res
