@@ -9,7 +9,11 @@ with numpy, or the files under ``benchmarks/data/realworld`` when present) meshe
 one constant size each into 100 to 100,000 triangles, printing per case aftmesh's
 time, Triangle's and their ratio, that ratio per triangle made (the two make
 different counts from the same boundary and size), and the per-stage breakdown
-(generate's ``info["timing"]``).
+(generate's ``info["timing"]``).  Beside the counts: the input's median edge length
+over the size (``edge/h``) and the count a uniform mesh of the size would have
+(``uniform``): where the input's vertices are closer than the size, every mesher
+keeps them, and aftmesh grades its triangles from their spacing up to the size
+(Triangle refines only as far as its angle bound needs).
 
 Times are process CPU time unless marked wall.  aftmesh and Triangle are timed call
 by call in turns, so a burst of load on a shared machine weighs on both; still run it
@@ -100,6 +104,21 @@ class Outline:
             len(shapely.get_coordinates(self.geometry))
             - shapely.get_num_geometries(shapely.get_rings(self.geometry)).sum()
         )
+
+    @property
+    def uniform_triangles(self) -> int:
+        """Equilateral triangles of side `size` that the area holds: the count a mesh
+        of that size alone would have, before any refinement towards the boundary."""
+        return round(self.polygon.area / (EQUILATERAL * self.size**2))
+
+    @property
+    def edge_over_size(self) -> float:
+        """The input's median edge length over the size: below 1, the input vertices
+        (which every mesher keeps) are closer than the size asks, and well-shaped
+        triangles next to them are smaller than it."""
+        d = self.triangle_dict()
+        ends = np.asarray(d["vertices"])[np.asarray(d["segments"])]
+        return float(np.median(np.hypot(*(ends[:, 1] - ends[:, 0]).T))) / self.size
 
     def triangle_dict(self) -> dict:
         if self.geometry is not None:
@@ -376,8 +395,8 @@ def stage_medians(aft: Callable[[], object], calls: int) -> list[float]:
 def run_real(budget: float, breakdown: bool, folder: Path = REALWORLD) -> None:
     rows, per_tri = [], []
     header = (
-        f"{'case':<22}{'verts':>7}{'aft tri':>8}{'Tri tri':>8}{'aft ms':>9}{'tri ms':>9}"
-        f"{'ratio':>7}{'per tri':>8}"
+        f"{'case':<22}{'verts':>7}{'edge/h':>7}{'uniform':>8}{'aft tri':>8}{'Tri tri':>8}"
+        f"{'aft ms':>9}{'tri ms':>9}{'ratio':>7}{'per tri':>8}"
     )
     print(header + ("  " + " ".join(TIMING_COLUMNS) + " (wall ms)" if breakdown else ""))
     for case in real_outlines(folder):
@@ -392,7 +411,8 @@ def run_real(budget: float, breakdown: bool, folder: Path = REALWORLD) -> None:
         # from the same boundary and size
         per_tri.append((ta / len(mesh.triangles)) / (tt / n_tri))
         line = (
-            f"{case.name:<22}{case.n_vertices:>7}{len(mesh.triangles):>8}{n_tri:>8}"
+            f"{case.name:<22}{case.n_vertices:>7}{case.edge_over_size:7.2f}"
+            f"{case.uniform_triangles:>8}{len(mesh.triangles):>8}{n_tri:>8}"
             f"{1e3 * ta:9.2f}{1e3 * tt:9.2f}{ta / tt:7.2f}{per_tri[-1]:8.2f}"
         )
         if breakdown:
