@@ -46,7 +46,9 @@ DEFAULT_CALLS = 3
 # stages both reach them.  Their C names are the Cython module's prefix and the name.
 # Stages may nest: "insert" (Delaunay point insertion) counts the background field's
 # own insertions as well as the boundary CDT's; "kernel" is the compiled common case
-# (0 where the Python stages run instead).
+# (0 where the Python stages run instead); "refine" is the whole minimum-angle pass
+# with its settling rounds (refine.pxi's refine_settled, the entry of both paths: the
+# refine_mesh it may end with is only the pass's second run).
 STAGES = (
     ("kernel", "generate_common"),
     ("bgfield", "background_field"),
@@ -54,7 +56,7 @@ STAGES = (
     ("insert", "insert_points"),
     ("front", "basic_aft_loop"),
     ("smooth", "smooth"),
-    ("refine", "refine_mesh"),
+    ("refine", "refine_settled"),
 )
 # A function line of callgrind_annotate --inclusive=yes: the count, then the file and
 # the C name (after "kernel_", optionally a Cython def wrapper's number).
