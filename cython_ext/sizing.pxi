@@ -39,6 +39,11 @@ from libc.stdint cimport int32_t
 from sizing cimport SizeField
 
 
+# i % 3 for i < 5, by table: the walk below indexes with it several times per step,
+# and a load is cheaper than the multiply and shifts a compiled % 3 becomes
+cdef int[5] _MOD3 = [0, 1, 2, 0, 1]
+
+
 cdef void size_field_free(SizeField* S) noexcept nogil:
     free(S.xy)
     free(S.w)
@@ -47,8 +52,9 @@ cdef void size_field_free(SizeField* S) noexcept nogil:
     free(S.nb)
     free(S.txy)
     free(S.op)
+    free(S.tedge)
     free(S.vhint)
-    S.xy = S.w = S.g = S.txy = NULL
+    S.xy = S.w = S.g = S.txy = S.tedge = NULL
     S.tv = S.nb = S.op = S.vhint = NULL
     S.nv = S.nt = S.vhint_cap = 0
     S.hint = 0
@@ -60,6 +66,8 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     """Replace S by copies of the given arrays (nt == 0: the constant) and the arrays
     derived from them; 0 or ERR_NOMEM."""
     cdef int t, k, j, n
+    cdef const double* a
+    cdef const double* b
     size_field_free(S)
     S.constant = constant
     S.rate = rate
@@ -73,8 +81,9 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     S.nb = <int32_t*> malloc(3 * nt * sizeof(int32_t))
     S.txy = <double*> malloc(6 * nt * sizeof(double))
     S.op = <int32_t*> malloc(3 * nt * sizeof(int32_t))
+    S.tedge = <double*> malloc(12 * nt * sizeof(double))
     if (S.xy == NULL or S.w == NULL or S.g == NULL or S.tv == NULL or S.nb == NULL
-            or S.txy == NULL or S.op == NULL):
+            or S.txy == NULL or S.op == NULL or S.tedge == NULL):
         size_field_free(S)
         return -1
     memcpy(S.xy, xy, 2 * nv * sizeof(double))
@@ -82,6 +91,10 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     memcpy(S.g, g, nv * sizeof(double))
     memcpy(S.tv, tv, 3 * nt * sizeof(int32_t))
     memcpy(S.nb, nb, 3 * nt * sizeof(int32_t))
+    S.w_finite = True
+    for k in range(nv):
+        if isinf(w[k]):
+            S.w_finite = False
     for t in range(nt):
         for k in range(3):
             S.txy[6 * t + 2 * k] = xy[2 * tv[3 * t + k]]
@@ -93,20 +106,25 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
                     if nb[3 * n + j] == t:
                         S.op[3 * t + k] = tv[3 * n + j]
                         break
+        for k in range(3):
+            a = &S.txy[6 * t + 2 * _MOD3[k + 1]]
+            b = &S.txy[6 * t + 2 * _MOD3[k + 2]]
+            S.tedge[12 * t + 4 * k] = a[0]
+            S.tedge[12 * t + 4 * k + 1] = a[1]
+            S.tedge[12 * t + 4 * k + 2] = b[0] - a[0]
+            S.tedge[12 * t + 4 * k + 3] = b[1] - a[1]
     S.nv = nv
     S.nt = nt
     return 0
 
 
-# i % 3 for i < 5, by table: the walk below indexes with it several times per step,
-# and a load is cheaper than the multiply and shifts a compiled % 3 becomes
-cdef int[5] _MOD3 = [0, 1, 2, 0, 1]
 
 
-cdef inline double _side(const double* a, const double* b, double x, double y) noexcept nogil:
-    # twice the signed area of (a, b, p): > 0 when p is left of a -> b (floating
-    # point is enough: the result only weighs sizes, it never decides topology)
-    return (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])
+cdef inline double _side_of_edge(const double* q, double x, double y) noexcept nogil:
+    # twice the signed area of (a, b, p), > 0 when p is left of a -> b, from a and
+    # b - a as tedge keeps them (floating point is enough: the result only weighs
+    # sizes, it never decides topology)
+    return q[2] * (y - q[1]) - q[3] * (x - q[0])
 
 
 cdef int size_locate(SizeField* S, double x, double y, double* side,
@@ -114,20 +132,21 @@ cdef int size_locate(SizeField* S, double x, double y, double* side,
     """The background triangle holding (x, y), or the last one a walk towards it
     reached (at the hull, or after as many steps as there are triangles: rounding can
     make a walk circle, and any nearby triangle gives a good enough size).  When the
-    walk ended inside it, side[k] holds _side of (x, y) from its edge k (opposite its
-    corner k) and sides_known is set: size_at's weights, already computed."""
+    walk ended inside it, side[k] holds _side_of_edge of (x, y) from its edge k
+    (opposite its corner k) and sides_known is set: size_at's weights, already
+    computed."""
     cdef int t = S.hint, step, k, j, n, first = 0
-    cdef const double* c
+    cdef const double* q
     sides_known[0] = False
     if t < 0 or t >= S.nt:
         t = 0
     for step in range(S.nt):
-        c = &S.txy[6 * t]
+        q = &S.tedge[12 * t]
         n = -1
         sides_known[0] = True
         for j in range(3):
             k = _MOD3[first + j]    # rotate the first edge tried: no walk cycles for good
-            side[k] = _side(&c[2 * _MOD3[k + 1]], &c[2 * _MOD3[k + 2]], x, y)
+            side[k] = _side_of_edge(&q[4 * k], x, y)
             if side[k] < 0.0:
                 n = S.nb[3 * t + k]
                 sides_known[0] = False
@@ -167,18 +186,22 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     p = &S.txy[6 * t]
     for k in range(3):
         if not known:
-            lam[k] = _side(&p[2 * _MOD3[k + 1]], &p[2 * _MOD3[k + 2]], x, y)
+            lam[k] = _side_of_edge(&S.tedge[12 * t + 4 * k], x, y)
         if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
             lam[k] = 0.0
         s += lam[k]
     if not s > 0.0:
         lam[0] = lam[1] = lam[2] = 1.0
         s = 3.0
-    for k in range(3):
-        if isinf(S.w[v[k]]):
-            h = INFINITY
-            break
-        h += lam[k] * S.w[v[k]]
+    if S.w_finite:
+        for k in range(3):
+            h += lam[k] * S.w[v[k]]
+    else:
+        for k in range(3):
+            if isinf(S.w[v[k]]):
+                h = INFINITY
+                break
+            h += lam[k] * S.w[v[k]]
     h /= s
     # a cone is never below its vertex's g (it only grows away from the vertex, and
     # adding a non-negative term never rounds down), so a vertex whose g is not below
