@@ -52,7 +52,7 @@ DEFAULT_CALLS = 3
 STAGES = (
     ("kernel", "generate_common"),
     ("bgfield", "background_field"),
-    ("discr", "discretize_boundary"),
+    ("discr", "_discretize_on"),
     ("insert", "insert_points"),
     ("front", "basic_aft_loop"),
     ("smooth", "smooth"),

@@ -644,6 +644,16 @@ cdef class Triangulation:
 
     # ------------------------------------------------------------ Basic_aft
 
+    cdef void adopt_size_field(self, SizeField* S) noexcept:
+        """Take S's arrays as the size field (S is left empty), its walks starting
+        afresh as set_size_field's do."""
+        size_field_free(&self.A.size)
+        self.A.size = S[0]
+        memset(S, 0, sizeof(SizeField))
+        self.A.size.hint = 0
+        self.A.size.vhint = NULL
+        self.A.size.vhint_cap = 0
+
     def set_size_field(self, double constant, const double[:, ::1] xy,
                        const double[::1] w, const double[::1] g, const int32_t[:, ::1] tv,
                        const int32_t[:, ::1] nb, double rate, double reach):
@@ -1470,6 +1480,18 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     onto the one before it or onto the segment's end is dropped (a piece of zero
     length would be fatal).  (total, None, None) as discretize_segments."""
     cdef SizeField S
+    memset(&S, 0, sizeof(SizeField))     # freed in the end, whatever raised
+    try:
+        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
+        return _discretize_on(&S, vertices, segments, source, max_samples, max_pieces)
+    finally:
+        size_field_free(&S)
+
+
+cdef object _discretize_on(SizeField* S, const double[:, ::1] vertices,
+                           const int32_t[:, ::1] segments, const int32_t[::1] source,
+                           int max_samples, double max_pieces):
+    """discretize_boundary on the field S (its walks start from S.hint)."""
     cdef Py_ssize_t m = segments.shape[0], nv = vertices.shape[0], n_pts = 0, kept = 0
     cdef double total = 0.0
     cdef double* pts
@@ -1481,16 +1503,14 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
     cdef double* cum = <double*> malloc(max_samples * sizeof(double))
     cdef int64_t* pieces = <int64_t*> malloc(max(m, 1) * sizeof(int64_t))
     cdef SampleStore K
-    memset(&S, 0, sizeof(SizeField))     # freed in the end, whatever raised
     try:
         if _store_init(&K, m) or cum == NULL or pieces == NULL:
             raise MemoryError()
-        _field_of(&S, constant, xy, w, g, tv, nb, rate, reach)
         # a background makes every sample a walk; with a constant, small inputs are
         # a few microseconds (see NOGIL_MIN_ITEMS)
         release = S.nt > 0 or m >= NOGIL_MIN_ITEMS
         if m:
-            total = _count_pieces(&S, &vertices[0, 0], &segments[0, 0], m, max_samples, cum,
+            total = _count_pieces(S, &vertices[0, 0], &segments[0, 0], m, max_samples, cum,
                                   pieces, &n_pts, &K, release)
         if not total <= max_pieces:
             return total, None, None
@@ -1516,7 +1536,6 @@ def discretize_boundary(double constant, const double[:, ::1] xy, const double[:
         free(cum)
         free(pieces)
         sample_store_free(&K)
-        size_field_free(&S)
     return v_out, s_out, e_out
 
 

@@ -11,11 +11,12 @@
 # classify, report progress or raise, this call returns None first and the caller
 # runs them instead (from the start: nothing here has side effects).
 #
-# Uses: the kernel's def layer (background_field, size_field_count,
-# discretize_boundary, Triangulation) and inputs.pxi's checks; past the boundary's
-# discretization, the C routines under Triangulation's methods directly (_insert_pslg,
-# domain.pxi, front.pxi, smoothing.pxi, refine.pxi), so that they run in one nogil
-# stretch.
+# Uses: the kernel's def layer (background_field, Triangulation) and inputs.pxi's
+# checks; one C copy of the size field (sizing.pxi) for the count, the discretization
+# (_discretize_on) and the front, which Triangulation.adopt_size_field takes over; past
+# the boundary's discretization, the C routines under Triangulation's methods directly
+# (_insert_pslg, domain.pxi, front.pxi, smoothing.pxi, refine.pxi), so that they run
+# in one nogil stretch.
 
 from libc.math cimport nextafter, pow, INFINITY, isfinite, fabs
 from posix.time cimport clock_gettime, timespec, CLOCK_MONOTONIC
@@ -317,11 +318,11 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
     counts or None, (t_boundary, t_cdt, t_aft) perf_counter times)."""
-    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0], i, nv
+    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0], i
     cdef double box[4]
-    cdef double expected, h_min, covered, share, hint_f, res
-    cdef long long hint
+    cdef double res
     cdef double* short
+    cdef SizeField S
     if rules.shape[0] != N_RULES:
         raise ValueError(f"rules must hold {N_RULES} values")
     if (m == 0 or n < 3 or source.shape[0] != m or not (constant > 0 and isfinite(constant))
@@ -347,23 +348,50 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
         free(short)
     if field is False:
         return None
+    # one copy of the field serves the count, the discretization and the front, each
+    # walking from the first background triangle as a fresh copy would
+    memset(&S, 0, sizeof(SizeField))
+    try:
+        return _generate_on(&S, field, vertices, segments, source, edge_source, classify,
+                            constant, area, rules, rounds, max_pieces, progress_limit,
+                            order, max_triangles, min_area, close_factor, swaps, greedy,
+                            smooth_rounds, slide, min_angle, scaffold, n)
+    finally:
+        size_field_free(&S)
+
+
+cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertices,
+                         const int32_t[:, ::1] segments, const int32_t[::1] source,
+                         const int32_t[::1] edge_source, bint classify, double constant,
+                         double area, const double[::1] rules, object rounds,
+                         double max_pieces, double progress_limit, int order,
+                         long long max_triangles, object min_area, double close_factor,
+                         bint swaps, bint greedy, int smooth_rounds, bint slide,
+                         double min_angle, bint scaffold, Py_ssize_t n):
+    """generate_common from its size field on (field: _common_field's arrays, or None
+    for the constant), S the kernel's copy of it, which the triangulation takes."""
+    cdef double expected, h_min, covered, share, hint_f, total
+    cdef long long hint
+    cdef Py_ssize_t nv
     if field is None:
         expected = area / (rules[RULE_EQUILATERAL_AREA] * constant) / constant
         h_min = constant
-        args = (constant, _NO_POINTS, _NO_VALUES, _NO_VALUES, _NO_TRIANGLES, _NO_TRIANGLES,
-                0.0, 0.0)
+        _field_of(S, constant, _NO_POINTS, _NO_VALUES, _NO_VALUES, _NO_TRIANGLES,
+                  _NO_TRIANGLES, 0.0, 0.0)
     else:
-        args = (constant,) + field
-        total, covered = size_field_count(*args, rules[RULE_MIN_ESTIMATE_RATE],
-                                          rules[RULE_EQUILATERAL_AREA])
+        _field_of(S, constant, field[0], field[1], field[2], field[3], field[4], field[5],
+                  field[6])
+        total = count_triangles_asked(S, rules[RULE_MIN_ESTIMATE_RATE],
+                                      rules[RULE_EQUILATERAL_AREA], &covered)
         share = area / (covered if covered >= 1e-300 else 1e-300)
         expected = total * (share if share < 1.0 else 1.0) * rules[RULE_ESTIMATE_MARGIN]
         h_min = _smallest_size(field[1], field[2])
     if not expected <= rules[RULE_MAX_TRIANGLES]:
         return None
     t_boundary = perf_counter()
-    out = discretize_boundary(*args, vertices, segments, source,
-                              <int> rules[RULE_MAX_SAMPLES], max_pieces)
+    S.hint = 0
+    out = _discretize_on(S, vertices, segments, source, <int> rules[RULE_MAX_SAMPLES],
+                         max_pieces)
     if out[1] is None:
         return None
     v_out, s_out, e_out = out
@@ -380,7 +408,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
         min_area = rules[RULE_MIN_AREA_FACTOR] * pow(h_min, 2.0)
     cdef Triangulation tri = Triangulation(
         v_out, <int> min(hint, <long long> rules[RULE_MAX_PREALLOCATED]))
-    tri.set_size_field(*args)
+    tri.adopt_size_field(S)
     tri.set_options(order=order, max_triangles=max_triangles, min_area=float(min_area),
                     close_factor=close_factor, swaps=swaps, greedy=greedy,
                     scaffold=scaffold)
