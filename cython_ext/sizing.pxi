@@ -50,11 +50,10 @@ cdef void size_field_free(SizeField* S) noexcept nogil:
     free(S.g)
     free(S.tv)
     free(S.nb)
-    free(S.txy)
     free(S.op)
     free(S.tedge)
     free(S.vhint)
-    S.xy = S.w = S.g = S.txy = S.tedge = NULL
+    S.xy = S.w = S.g = S.tedge = NULL
     S.tv = S.nb = S.op = S.vhint = NULL
     S.nv = S.nt = S.vhint_cap = 0
     S.hint = 0
@@ -79,11 +78,10 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     S.g = <double*> malloc(nv * sizeof(double))
     S.tv = <int32_t*> malloc(3 * nt * sizeof(int32_t))
     S.nb = <int32_t*> malloc(3 * nt * sizeof(int32_t))
-    S.txy = <double*> malloc(6 * nt * sizeof(double))
     S.op = <int32_t*> malloc(3 * nt * sizeof(int32_t))
     S.tedge = <double*> malloc(12 * nt * sizeof(double))
     if (S.xy == NULL or S.w == NULL or S.g == NULL or S.tv == NULL or S.nb == NULL
-            or S.txy == NULL or S.op == NULL or S.tedge == NULL):
+            or S.op == NULL or S.tedge == NULL):
         size_field_free(S)
         return -1
     memcpy(S.xy, xy, 2 * nv * sizeof(double))
@@ -97,8 +95,6 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
             S.w_finite = False
     for t in range(nt):
         for k in range(3):
-            S.txy[6 * t + 2 * k] = xy[2 * tv[3 * t + k]]
-            S.txy[6 * t + 2 * k + 1] = xy[2 * tv[3 * t + k] + 1]
             S.op[3 * t + k] = -1
             n = nb[3 * t + k]
             if n >= 0:
@@ -106,9 +102,8 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
                     if nb[3 * n + j] == t:
                         S.op[3 * t + k] = tv[3 * n + j]
                         break
-        for k in range(3):
-            a = &S.txy[6 * t + 2 * _MOD3[k + 1]]
-            b = &S.txy[6 * t + 2 * _MOD3[k + 2]]
+            a = &xy[2 * tv[3 * t + _MOD3[k + 1]]]
+            b = &xy[2 * tv[3 * t + _MOD3[k + 2]]]
             S.tedge[12 * t + 4 * k] = a[0]
             S.tedge[12 * t + 4 * k + 1] = a[1]
             S.tedge[12 * t + 4 * k + 2] = b[0] - a[0]
@@ -178,15 +173,15 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     cdef double s = 0.0, h = 0.0, c
     cdef bint known
     cdef const int32_t* v
-    cdef const double* p
+    cdef const double* e
     if S.nt == 0:
         return S.constant
     t = size_locate(S, x, y, lam, &known)
     v = &S.tv[3 * t]
-    p = &S.txy[6 * t]
+    e = &S.tedge[12 * t]
     for k in range(3):
         if not known:
-            lam[k] = _side_of_edge(&S.tedge[12 * t + 4 * k], x, y)
+            lam[k] = _side_of_edge(&e[4 * k], x, y)
         if not lam[k] > 0.0:        # outside that edge, or NaN: its nearest point
             lam[k] = 0.0
         s += lam[k]
@@ -208,7 +203,7 @@ cdef double size_at(SizeField* S, double x, double y) noexcept nogil:
     # h cannot lower it: skipping its square root changes no result
     for k in range(3):
         if S.g[v[k]] < h:
-            c = _cone(S, v[k], &p[2 * k], x, y)
+            c = _cone(S, v[k], &e[4 * _MOD3[k + 2]], x, y)     # edge k + 2 starts at k
             if c < h:
                 h = c
         a = S.op[3 * t + k]
