@@ -12,10 +12,10 @@ cdef struct SizeField:
     # derived from the above by size_field_set, so that a look-up reads one triangle's
     # data in one place instead of chasing indices:
     int32_t* op         # 3 per triangle: the far vertex of the neighbour nb[k], -1 none
-    double* tedge       # 12 per triangle: for the edge opposite corner k, its start
-                        # (corner k + 1, so the three starts are the corners) and its
-                        # direction (corner k + 2 - corner k + 1): the walk's side
-                        # tests, two products each
+    # 12 per triangle: for the edge opposite corner k, its start (corner k + 1, so the
+    # three starts are the corners) and its direction (corner k + 2 - corner k + 1):
+    # the walk's side tests, two products each
+    double* tedge
     bint w_finite       # no vertex's w is infinite: the interpolation skips the test
     double rate         # a vertex's size g grows by at most this per unit of distance ...
     double reach        # ... beyond this many times g from the vertex

@@ -113,8 +113,6 @@ cdef int size_field_set(SizeField* S, double constant, int nv, int nt, const dou
     return 0
 
 
-
-
 cdef inline double _side_of_edge(const double* q, double x, double y) noexcept nogil:
     # twice the signed area of (a, b, p), > 0 when p is left of a -> b, from a and
     # b - a as tedge keeps them (floating point is enough: the result only weighs
