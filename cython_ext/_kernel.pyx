@@ -650,6 +650,7 @@ cdef class Triangulation:
         size_field_free(&self.A.size)
         self.A.size = S[0]
         memset(S, 0, sizeof(SizeField))
+        free(self.A.size.vhint)     # S's look-ups' vertex hints, if it had any
         self.A.size.hint = 0
         self.A.size.vhint = NULL
         self.A.size.vhint_cap = 0
