@@ -68,6 +68,7 @@ include "sliding.pxi"
 include "inputs.pxi"
 include "nearby.pxi"
 include "crossings.pxi"
+include "simple_rings.pxi"
 include "discretize.pxi"
 include "background.pxi"
 include "resolve.pxi"
@@ -1121,6 +1122,32 @@ def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t 
         k = ring_chains_into(&xy[0, 0], &ring_of[0], n, &mid[0, 0], &ring[0],
                              &pts[0, 0], &edge[0], &seg[0, 0], &removed[0])
     return pts_arr[:k], seg_arr[:k], edge_arr[:k], mid_arr, ring_arr, removed_arr
+
+
+def rings_proved_valid(const double[:, ::1] pts, const int64_t[:, ::1] seg,
+                       const int64_t[::1] edge, const int64_t[::1] ring, Py_ssize_t n_rings):
+    """Whether ring_chains' output (points, segments, input edge of each segment, ring
+    of each input edge) is proved a valid polygon, ring 0 its exterior: rings simple,
+    meeting nowhere, holes inside the exterior and outside each other (see
+    simple_rings.pxi).  False means not proved, not invalid."""
+    cdef Py_ssize_t n = pts.shape[0], m = seg.shape[0], k
+    cdef int res
+    if seg.shape[1] != 2 or pts.shape[1] != 2 or edge.shape[0] != m:
+        raise ValueError("points and segments must have two columns, edges one per segment")
+    for k in range(m):
+        if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n
+                and 0 <= edge[k] < ring.shape[0]):
+            raise ValueError(f"segment {k} points outside the points or the edges")
+    if m == 0:
+        return False
+    if m >= NOGIL_MIN_ITEMS:
+        with nogil:
+            res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m, n_rings)
+    else:
+        res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m, n_rings)
+    if res < 0:
+        raise MemoryError("proving the rings valid")
+    return res == 1
 
 
 def coordinate_problems(const double[:, ::1] xy, double lo, double hi):

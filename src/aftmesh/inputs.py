@@ -27,12 +27,12 @@ from shapely.geometry import (
     Polygon,
 )
 
-from ._kernel import ring_chains
+from ._kernel import coordinate_problems, ring_chains, rings_proved_valid
 from ._typing import DomainArg
 from .domain_record import Domain
 from .errors import InvalidDomainError
 from .noding import merge_and_node
-from .pslg import check_range
+from .pslg import MAX_COORDINATE, MIN_COORDINATE, check_range
 from .pslg_input import from_dict, from_poly_file
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
@@ -163,6 +163,23 @@ def _from_shapely(
     `coords`: the coordinates of a lone polygon, if check_polygon has them."""
     note: list[str] = []
     rings = _ring_arrays(polygons, names, note, coords)
+    return _noded(rings, note, polygons, lines, line_names, points, tolerance, valid, area)
+
+
+def _noded(
+    rings: tuple,
+    note: list[str],
+    polygons: list[Polygon],
+    lines: list,
+    line_names: list[str],
+    points: list,
+    tolerance: float,
+    valid: bool,
+    area: float | None,
+    apart: bool = False,
+) -> Domain:
+    """_from_shapely's Domain from the rings' arrays (_ring_arrays); `apart`: the
+    rings are known to meet nowhere (see merge_and_node)."""
     n_rings = len(rings[5])
     verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
     edge_source = source.astype(np.int32)
@@ -172,7 +189,7 @@ def _from_shapely(
     if valid and not lines and not points:
         valid_rings = len(source_names)
     verts, segs, edges = merge_and_node(
-        verts, segs, edges, note, is_ring, tolerance, report, valid_rings
+        verts, segs, edges, note, is_ring, tolerance, report, valid_rings, apart
     )
     return Domain(
         verts,
@@ -188,6 +205,31 @@ def _from_shapely(
         report={"tolerance": report} if report else {},
         n_rings=n_rings,
     )
+
+
+def proved_polygon(poly: Polygon) -> Domain | None:
+    """from_geometry(poly) for a lone Polygon whose rings the kernel proves a valid
+    polygon (rings_proved_valid: simple, meeting nowhere, holes in place), without
+    GEOS's validity check, which costs more than the rest of the conversion on a small
+    polygon; None when anything is not plainly fine (empty, z values, a coordinate
+    not finite or out of range, rings not proved), and from_geometry then decides,
+    with its messages.  The Domain is the one from_geometry makes."""
+    coords = shapely.get_coordinates(poly)
+    if (
+        len(coords) == 0
+        or shapely.get_coordinate_dimension(poly) != 2
+        or coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE)
+    ):
+        return None
+    area = float(poly.area)
+    if not area > 0:
+        return None
+    note: list[str] = []
+    rings = _ring_arrays([poly], ["the polygon"], note, coords)
+    pts, segs, edges, ring = rings[0], rings[1], rings[2], rings[3]
+    if not rings_proved_valid(pts, segs, edges, ring, len(rings[5])):
+        return None
+    return _noded(rings, note, [poly], [], [], [], 0.0, True, area, apart=True)
 
 
 def _split_geometry(domain):
@@ -338,6 +380,10 @@ def to_domain(
     splits them exactly); `tolerance` merges vertices closer than it and snaps line
     ends onto segments that near (0: exact); `repair` makes invalid polygons valid
     first (see :mod:`aftmesh.repair`).  What these changed is in ``Domain.report``."""
+    if type(domain) is Polygon and not repair and not tolerance > 0:
+        proved = proved_polygon(domain)
+        if proved is not None:
+            return proved
     repaired = None
     if repair:
         domain, repaired = repair_domain(domain, is_coordinate_array(domain))

@@ -81,6 +81,7 @@ def merge_and_node(
     tolerance: float = 0.0,
     report: dict | None = None,
     valid_rings: int = 0,
+    apart: bool = False,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Make the input edges a proper PSLG: merge coincident vertices, split every
     segment at the input vertices lying on it or within rounding of it (a hole touching
@@ -99,7 +100,9 @@ def merge_and_node(
     on another segment either (the ring is simple, and a ring's vertex is never
     snapped), so the split is skipped, and so is the search for repeated segments;
     with several small rings, a pairwise look in the kernel says whether any of that
-    is needed at all (rings touching at a point are rare)."""
+    is needed at all (rings touching at a point are rare).  `apart` says more: the
+    valid rings meet nowhere (the kernel proved it, inputs.proved_polygon), so none of
+    it is needed, however many rings there are."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
@@ -108,9 +111,10 @@ def merge_and_node(
     uniq, inverse = unique_rows(verts)
     segs = inverse[segs]
     exact_valid = valid_rings and not tolerance > 0
-    if exact_valid and valid_rings == 1:
-        # one simple ring of at least three distinct vertices: no vertex on another
-        # segment, no segment given twice or from a vertex to itself, no crossing
+    if exact_valid and (valid_rings == 1 or apart):
+        # one simple ring of at least three distinct vertices, or rings apart: no
+        # vertex on another segment, no segment given twice or from a vertex to
+        # itself, no crossing
         return uniq, segs, src
     if exact_valid and len(uniq) * len(segs) <= PROPER_CHECK_PAIRS and rings_proper(uniq, segs):
         # the rings of a valid polygon that touch nowhere (the usual polygon with

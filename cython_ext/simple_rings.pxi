@@ -1,0 +1,195 @@
+# Whether a polygon's rings are a valid polygon, proved without GEOS: every ring simple
+# (at least three vertices, no two of its edges meeting but consecutive ones at their
+# common vertex, and those not folding back), no two rings meeting anywhere, and every
+# hole inside the exterior ring and outside the other holes.  Rings that meet nowhere
+# leave the interior connected, so such a polygon is valid in the OGC sense shapely and
+# GEOS use; what this cannot prove (rings touching at a point, which can be valid too,
+# or a search past its caps) is left to GEOS, which then also names what is wrong.
+#
+# The search for meeting edges is crossings.pxi's: two closed segments that meet share a
+# point inside both boxes, hence a cell of nearby.pxi's grid, and each cell's pairs are
+# tested by exact orient2d.  A hole's place is the crossing number of a ray from its
+# first vertex, by exact orient2d and exact comparisons of y: with the rings apart, the
+# vertex lies on no edge, so the count is never ambiguous.
+#
+# Uses: nearby.pxi (_Grid, _grid_build); crossings.pxi (CROSSING_PAIRS_PER_SEGMENT);
+# predicates.pxi (orient2d).
+from libc.stdint cimport int64_t
+from libc.stdlib cimport malloc, free
+
+# The hole placement tests (holes times segments) allowed before leaving the proof to
+# GEOS: quadratic in the holes, so a polygon with thousands of holes is not looked at
+# hole by hole (GEOS's own index handles it).
+cdef int64_t HOLE_TESTS_MAX = 250_000
+
+
+cdef inline bint _on_span(const double* a, const double* b, const double* c) noexcept nogil:
+    # c, known to be on the line ab, lies within the closed box of a and b
+    return (min(a[0], b[0]) <= c[0] <= max(a[0], b[0])
+            and min(a[1], b[1]) <= c[1] <= max(a[1], b[1]))
+
+
+cdef bint _segments_meet(const double* a, const double* b, const double* c,
+                         const double* d) noexcept nogil:
+    """Whether the closed segments ab and cd have a point in common (exact)."""
+    cdef int o1, o2, o3, o4
+    if (max(a[0], b[0]) < min(c[0], d[0]) or max(c[0], d[0]) < min(a[0], b[0])
+            or max(a[1], b[1]) < min(c[1], d[1]) or max(c[1], d[1]) < min(a[1], b[1])):
+        return False
+    o1 = orient2d(a, b, c)
+    o2 = orient2d(a, b, d)
+    o3 = orient2d(c, d, a)
+    o4 = orient2d(c, d, b)
+    if o1 != o2 and o3 != o4 and o1 * o2 <= 0 and o3 * o4 <= 0:
+        return True             # they cross, or an end of one is inside the other
+    return ((o1 == 0 and _on_span(a, b, c)) or (o2 == 0 and _on_span(a, b, d))
+            or (o3 == 0 and _on_span(c, d, a)) or (o4 == 0 and _on_span(c, d, b)))
+
+
+cdef inline bint _folds_back(const double* a, const double* b, const double* c) noexcept nogil:
+    # consecutive edges ab, bc overlap beyond b: c on the line, on a's side of b
+    if orient2d(a, b, c) != 0:
+        return False
+    if a[0] != b[0]:
+        return (a[0] < b[0]) == (c[0] < b[0]) or c[0] == b[0]
+    return (a[1] < b[1]) == (c[1] < b[1]) or c[1] == b[1]
+
+
+cdef bint _inside_ring(const double* xy, const int64_t* seg, Py_ssize_t s0, Py_ssize_t s1,
+                       const double* p) noexcept nogil:
+    """Whether p, on none of its edges, is inside the ring of segments s0..s1 - 1: the
+    parity of the edges crossing the ray from p towards +x (an edge counts when its
+    ends lie on either side of p's y, the upper one not below it)."""
+    cdef Py_ssize_t k
+    cdef const double* a
+    cdef const double* b
+    cdef bint inside = False
+    for k in range(s0, s1):
+        a = &xy[2 * seg[2 * k]]
+        b = &xy[2 * seg[2 * k + 1]]
+        if (a[1] > p[1]) != (b[1] > p[1]):
+            # p left of the edge taken upwards: the crossing is to p's right
+            if (orient2d(a, b, p) > 0) == (b[1] > a[1]):
+                inside = not inside
+    return inside
+
+
+cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ring,
+                      Py_ssize_t m, Py_ssize_t n_rings, Py_ssize_t* start) noexcept nogil:
+    """start[r] .. start[r + 1]: ring r's segments (segment k's ring: ring[edge[k]]),
+    which must be consecutive, in ring order, closed, and at least three.  1, or 0
+    when they are not."""
+    cdef Py_ssize_t k, r = 0
+    start[0] = 0
+    for k in range(m):
+        if ring[edge[k]] != r:
+            if ring[edge[k]] != r + 1:
+                return 0
+            r += 1
+            start[r] = k
+    if r != n_rings - 1:
+        return 0
+    start[n_rings] = m
+    for r in range(n_rings):
+        if start[r + 1] - start[r] < 3:
+            return 0
+        for k in range(start[r], start[r + 1]):
+            if seg[2 * k] == seg[2 * k + 1]:
+                return 0
+            if seg[2 * k + 1] != (seg[2 * k + 2] if k + 1 < start[r + 1]
+                                  else seg[2 * start[r]]):
+                return 0
+    return 1
+
+
+cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
+                      Py_ssize_t m) noexcept nogil:
+    """1 when no two segments meet but consecutive ones of a ring at their shared end
+    (which _rings_fold_free judges), 0 when two do or the search gives up past
+    CROSSING_PAIRS_PER_SEGMENT tests per segment, -1 when out of memory."""
+    cdef _Grid G
+    cdef Py_ssize_t c, i, j, k, q
+    cdef int64_t tests = 0, cap = CROSSING_PAIRS_PER_SEGMENT * m
+    cdef int res = 1
+    G.start = NULL
+    G.item = NULL
+    if _grid_build(xy, n, seg, m, 0.0, &G):
+        free(G.start)
+        free(G.item)
+        return -1
+    for c in range(G.g * G.g):
+        for i in range(G.start[c], G.start[c + 1]):
+            k = G.item[i]
+            for j in range(i + 1, G.start[c + 1]):
+                q = G.item[j]
+                tests += 1
+                if tests > cap:
+                    res = 0
+                    break
+                if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
+                        or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
+                    continue        # consecutive: a shared vertex index
+                if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                                  &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
+                    res = 0
+                    break
+            if res == 0:
+                break
+        if res == 0:
+            break
+    free(G.start)
+    free(G.item)
+    return res
+
+
+cdef bint _rings_fold_free(const double* xy, const int64_t* seg, const Py_ssize_t* start,
+                           Py_ssize_t n_rings) noexcept nogil:
+    cdef Py_ssize_t r, k, nxt_k
+    for r in range(n_rings):
+        for k in range(start[r], start[r + 1]):
+            nxt_k = k + 1 if k + 1 < start[r + 1] else start[r]
+            if _folds_back(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                           &xy[2 * seg[2 * nxt_k + 1]]):
+                return False
+    return True
+
+
+cdef bint _holes_placed(const double* xy, const int64_t* seg, const Py_ssize_t* start,
+                        Py_ssize_t n_rings) noexcept nogil:
+    """Every hole (rings 1 on) inside the exterior (ring 0) and outside the other holes,
+    judged at its first vertex (the rings meet nowhere)."""
+    cdef Py_ssize_t r, q
+    cdef const double* p
+    for r in range(1, n_rings):
+        p = &xy[2 * seg[2 * start[r]]]
+        if not _inside_ring(xy, seg, start[0], start[1], p):
+            return False
+        for q in range(1, n_rings):
+            if q != r and _inside_ring(xy, seg, start[q], start[q + 1], p):
+                return False
+    return True
+
+
+cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const int64_t* edge,
+                     const int64_t* ring, Py_ssize_t m, Py_ssize_t n_rings) noexcept nogil:
+    """1 when the rings (ring_chains_into's n points, m segments, the input edge of
+    each and the ring of each input edge; ring 0 the exterior) are proved a valid
+    polygon (see the top of this file), 0 when not proved, -1 when out of memory."""
+    cdef Py_ssize_t* start
+    cdef int res
+    if n_rings < 1 or m < 3:
+        return 0
+    if n_rings > 1 and (n_rings - 1) * m > HOLE_TESTS_MAX:
+        return 0
+    start = <Py_ssize_t*> malloc((n_rings + 1) * sizeof(Py_ssize_t))
+    if start == NULL:
+        return -1
+    res = _ring_starts(seg, edge, ring, m, n_rings, start)
+    if res == 1 and not _rings_fold_free(xy, seg, start, n_rings):
+        res = 0
+    if res == 1:
+        res = _no_contacts(xy, n, seg, m)
+    if res == 1 and not _holes_placed(xy, seg, start, n_rings):
+        res = 0
+    free(start)
+    return res

@@ -1,0 +1,173 @@
+"""The kernel's proof that a lone polygon is valid (cython_ext/simple_rings.pxi, used
+by inputs.proved_polygon in place of GEOS's validity check) against GEOS: what it
+proves valid GEOS finds valid, the Domain it leads to is the one from_geometry makes,
+and what it cannot prove meshes, or is refused, as before."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+import shapely
+from hypothesis import given
+from hypothesis import strategies as st
+from shapely.geometry import Polygon, box
+
+import aftmesh
+from aftmesh import _kernel, inputs
+from aftmesh.errors import InvalidDomainError
+
+DOMAIN_ARRAYS = (
+    "vertices",
+    "segments",
+    "segment_edge",
+    "edge_source",
+    "edge_midpoints",
+    "edge_is_ring",
+)
+DOMAIN_FIELDS = ("source_names", "cleanup", "report", "area", "n_rings", "holes", "region_points")
+
+
+def assert_same_domain(a, b):
+    for name in DOMAIN_ARRAYS:
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.dtype == y.dtype and np.array_equal(x, y), name
+    for name in DOMAIN_FIELDS:
+        assert getattr(a, name) == getattr(b, name), name
+    assert len(a.polygons) == len(b.polygons) == 1 and a.polygons[0] is b.polygons[0]
+
+
+def check_against_geos(poly: Polygon) -> bool:
+    """proved_polygon(poly), held to GEOS and to from_geometry; whether it proved."""
+    proved = inputs.proved_polygon(poly)
+    if proved is None:
+        return False
+    assert poly.is_valid, poly.wkt
+    assert_same_domain(proved, inputs.from_geometry(poly))
+    return True
+
+
+# Few values on a small grid: rings that touch, overlap, fold back and nest often.
+grid = st.integers(0, 4).map(float)
+
+
+@st.composite
+def grid_polygons(draw):
+    def ring(lo, hi, n):
+        return draw(st.lists(st.tuples(lo, hi), min_size=n, max_size=n + 5))
+
+    shell = ring(grid, grid, 3)
+    holes = [ring(grid, grid, 3) for _ in range(draw(st.integers(0, 2)))]
+    return Polygon(shell, holes)
+
+
+@given(grid_polygons())
+def test_what_the_kernel_proves_valid_geos_finds_valid(poly):
+    check_against_geos(poly)
+
+
+# A unit square, and a hole whose corners sit a few ulps from its edges or from each
+# other: near-degenerate cases the proof must decide exactly.
+ulps = st.integers(-3, 3)
+
+
+@given(st.lists(st.tuples(ulps, ulps), min_size=4, max_size=4), st.floats(0.0, 1.0))
+def test_holes_an_ulp_from_the_exterior_are_judged_as_geos_judges_them(moves, t):
+    corners = [(0.5 * t, 0.0), (1.0, 0.5 * t), (1.0 - 0.5 * t, 1.0), (0.0, 1.0 - 0.5 * t)]
+    hole = [
+        (x + dx * math.ulp(1.0), y + dy * math.ulp(1.0)) for (x, y), (dx, dy) in zip(corners, moves)
+    ]
+    check_against_geos(Polygon([(0, 0), (1, 0), (1, 1), (0, 1)], [hole]))
+
+
+SQUARE = [(0, 0), (4, 0), (4, 4), (0, 4)]
+PINNED = {
+    # name: (polygon, proved, valid)
+    "square": (Polygon(SQUARE), True, True),
+    "square with a hole": (Polygon(SQUARE, [[(1, 1), (2, 1), (2, 2)]]), True, True),
+    "repeated vertices": (Polygon([(0, 0), (0, 0), (4, 0), (4, 4), (4, 4), (0, 4)]), True, True),
+    "collinear vertices": (Polygon([(0, 0), (2, 0), (4, 0), (4, 4), (0, 4)]), True, True),
+    "bow tie": (Polygon([(0, 0), (4, 4), (4, 0), (0, 4)]), False, False),
+    "spike folding back": (Polygon([(0, 0), (4, 0), (2, 0), (2, 4)]), False, False),
+    "ring touching itself": (
+        Polygon([(0, 0), (4, 0), (2, 2), (4, 4), (0, 4), (2, 2)]),
+        False,
+        False,
+    ),
+    "hole touching the exterior at a corner": (
+        Polygon(SQUARE, [[(0, 0), (1, 2), (2, 1)]]),
+        False,
+        True,
+    ),
+    "hole touching an exterior edge": (Polygon(SQUARE, [[(2, 0), (3, 1), (1, 1)]]), False, True),
+    "holes touching at a point": (
+        Polygon(SQUARE, [[(1, 1), (2, 2), (1, 2)], [(2, 2), (3, 3), (3, 2)]]),
+        False,
+        True,
+    ),
+    "hole outside": (Polygon(SQUARE, [[(5, 5), (6, 5), (6, 6)]]), False, False),
+    "nested holes": (
+        Polygon(
+            SQUARE, [[(0.5, 0.5), (3.5, 0.5), (3.5, 3.5), (0.5, 3.5)], [(1, 1), (2, 1), (2, 2)]]
+        ),
+        False,
+        False,
+    ),
+    "crossing holes": (
+        Polygon(SQUARE, [[(1, 1), (2, 1), (2, 2), (1, 2)], [(1.5, 1.5), (3, 1.5), (3, 3)]]),
+        False,
+        False,
+    ),
+    "z values": (Polygon([(0, 0, 1), (4, 0, 1), (4, 4, 1), (0, 4, 1)]), False, True),
+}
+
+
+@pytest.mark.parametrize("name", list(PINNED))
+def test_pinned_polygons_are_proved_only_when_valid_and_apart(name):
+    poly, proved, valid = PINNED[name]
+    assert poly.is_valid == valid
+    assert check_against_geos(poly) == proved
+
+
+@pytest.mark.parametrize("name", [n for n, (_, _, valid) in PINNED.items() if valid])
+def test_valid_polygons_mesh_the_same_with_and_without_the_proof(name, monkeypatch, checked):
+    poly = PINNED[name][0]
+    mesh = checked(aftmesh.generate(poly, 0.5))
+    with monkeypatch.context() as m:
+        m.setattr(inputs, "proved_polygon", lambda p: None)
+        plain = aftmesh.generate(poly, 0.5)
+    for array in ("points", "triangles", "segments", "segment_sources", "regions"):
+        assert np.array_equal(getattr(mesh, array), getattr(plain, array)), array
+    assert mesh.info["cleanup"] == plain.info["cleanup"]
+    assert mesh.info["sources"] == plain.info["sources"]
+
+
+@pytest.mark.parametrize("name", [n for n, (_, _, valid) in PINNED.items() if not valid])
+def test_invalid_polygons_are_still_refused_with_geos_reasons(name):
+    with pytest.raises(InvalidDomainError, match="not a valid polygon"):
+        aftmesh.generate(PINNED[name][0], 0.5)
+
+
+def test_a_polygon_with_many_holes_apart_is_proved_and_meshed(checked):
+    holes = [
+        shapely.Point(1 + 2 * i, 1 + 2 * j).buffer(0.4, 3).exterior.coords
+        for i in range(8)
+        for j in range(8)
+    ]
+    poly = Polygon(box(0, 0, 16, 16).exterior.coords, holes)
+    assert check_against_geos(poly)
+    mesh = checked(aftmesh.generate(poly, 0.5))
+    assert abs(mesh.area() - poly.area) < 1e-9 * poly.area
+
+
+def test_rings_proved_valid_refuses_indices_outside_its_arrays():
+    pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
+    edge = np.arange(3, dtype=np.int64)
+    ring = np.zeros(3, dtype=np.int64)
+    good = np.array([[0, 1], [1, 2], [2, 0]], dtype=np.int64)
+    assert _kernel.rings_proved_valid(pts, good, edge, ring, 1)
+    with pytest.raises(ValueError, match="segment 2"):
+        _kernel.rings_proved_valid(pts, np.array([[0, 1], [1, 2], [2, 3]]), edge, ring, 1)
+    with pytest.raises(ValueError, match="segment 0"):
+        _kernel.rings_proved_valid(pts, good, np.array([5, 1, 2]), ring, 1)
