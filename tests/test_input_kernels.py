@@ -208,6 +208,33 @@ def test_kept_whole_sizes_are_the_geometric_mean_at_wide_two_edge_vertices(pairs
     np.testing.assert_allclose(got, want, rtol=1e-14)
 
 
+def reference_hilbert_key(x: int, y: int, bits: int) -> int:
+    """The Hilbert index of cell (x, y), one level at a time (the textbook xy -> d)."""
+    d, side = 0, (1 << bits) - 1
+    for level in reversed(range(bits)):
+        s = 1 << level
+        rx, ry = int(bool(x & s)), int(bool(y & s))
+        d += s * s * ((3 * rx) ^ ry)
+        if ry == 0:
+            if rx == 1:
+                x, y = side - x, side - y
+            x, y = y, x
+    return d
+
+
+@pytest.mark.parametrize("bits", [1, 2, 3, 7, 16, 31])
+def test_hilbert_keys_two_levels_at_a_time_are_the_textbook_keys(bits):
+    rng = np.random.default_rng(bits)
+    side = (1 << bits) - 1
+    cells = rng.integers(0, side + 1, size=(300, 2))
+    cells[:4] = [[0, 0], [side, 0], [0, side], [side, side]]
+    # points at the cells' corners, in a box of side `side`: the cell is the point
+    xy = np.ascontiguousarray(cells.astype(np.float64))
+    got = _kernel.hilbert_keys(xy, bits)
+    want = [reference_hilbert_key(int(x), int(y), bits) for x, y in cells]
+    assert got.tolist() == want
+
+
 @pytest.mark.parametrize("n", [0, 1, 2, 9, 200, 5000])
 def test_brio_keys_order_is_the_stable_numpy_argsort(n):
     rng = np.random.default_rng(n)
