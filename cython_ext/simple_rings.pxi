@@ -6,17 +6,21 @@
 # GEOS use; what this cannot prove (rings touching at a point, which can be valid too,
 # or a search past its caps) is left to GEOS, which then also names what is wrong.
 #
-# The search for meeting edges is crossings.pxi's: two closed segments that meet share a
-# point inside both boxes, hence a cell of nearby.pxi's grid, and each cell's pairs are
-# tested by exact orient2d.  A hole's place is the crossing number of a ray from its
-# first vertex, by exact orient2d and exact comparisons of y: with the rings apart, the
-# vertex lies on no edge, so the count is never ambiguous.
+# Two closed segments that meet overlap in x and in y, so a sweep along the longer side
+# of the points' box tests each segment, by exact orient2d, against the segments whose
+# range along it overlaps its own: the ones the sweep line stabs, a few on the rings
+# people draw.  A hole's place is the crossing number of a ray from its first vertex,
+# by exact orient2d and exact comparisons of y: with the rings apart, the vertex lies
+# on no edge, so the count is never ambiguous.
 #
-# Uses: nearby.pxi (_Grid, _grid_build); crossings.pxi (CROSSING_PAIRS_PER_SEGMENT);
-# predicates.pxi (orient2d).
+# Uses: inputs.pxi (box_of, stable_order); predicates.pxi (orient2d).
 from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, free
 
+# Segment pairs tested per segment before leaving the proof to GEOS: the sweep line
+# stabs a few segments of a drawn ring, but a comb of many parallel teeth would make
+# the sweep quadratic.
+cdef int64_t PROOF_TESTS_PER_SEGMENT = 64
 # The hole placement tests (holes times segments) allowed before leaving the proof to
 # GEOS: quadratic in the holes, so a polygon with thousands of holes is not looked at
 # hole by hole (GEOS's own index handles it).
@@ -102,43 +106,67 @@ cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ri
     return 1
 
 
+cdef bint _lo_less(const void* data, Py_ssize_t i, Py_ssize_t j) noexcept nogil:
+    cdef const double* lo = <const double*> data
+    return lo[i] < lo[j]
+
+
 cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
                       Py_ssize_t m) noexcept nogil:
     """1 when no two segments meet but consecutive ones of a ring at their shared end
-    (which _rings_fold_free judges), 0 when two do or the search gives up past
-    CROSSING_PAIRS_PER_SEGMENT tests per segment, -1 when out of memory."""
-    cdef _Grid G
-    cdef Py_ssize_t c, i, j, k, q
-    cdef int64_t tests = 0, cap = CROSSING_PAIRS_PER_SEGMENT * m
+    (which _rings_fold_free judges), 0 when two do or the sweep gives up past
+    PROOF_TESTS_PER_SEGMENT tests per segment, -1 when out of memory."""
+    cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis
+    cdef int64_t tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
     cdef int res = 1
-    G.start = NULL
-    G.item = NULL
-    if _grid_build(xy, n, seg, m, 0.0, &G):
-        free(G.start)
-        free(G.item)
+    cdef double box[4]
+    cdef double u, v
+    cdef double* lo = <double*> malloc(2 * m * sizeof(double))
+    cdef int64_t* order = <int64_t*> malloc(3 * m * sizeof(int64_t))
+    cdef double* hi
+    cdef int64_t* work
+    cdef int64_t* active
+    if lo == NULL or order == NULL:
+        free(lo)
+        free(order)
         return -1
-    for c in range(G.g * G.g):
-        for i in range(G.start[c], G.start[c + 1]):
-            k = G.item[i]
-            for j in range(i + 1, G.start[c + 1]):
-                q = G.item[j]
-                tests += 1
-                if tests > cap:
-                    res = 0
-                    break
-                if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
-                        or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
-                    continue        # consecutive: a shared vertex index
-                if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
-                                  &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
-                    res = 0
-                    break
-            if res == 0:
+    hi = &lo[m]
+    work = &order[m]
+    active = &order[2 * m]
+    box_of(xy, n, box)
+    axis = 0 if box[2] - box[0] >= box[3] - box[1] else 1
+    for k in range(m):
+        u = xy[2 * seg[2 * k] + axis]
+        v = xy[2 * seg[2 * k + 1] + axis]
+        lo[k] = min(u, v)
+        hi[k] = max(u, v)
+    stable_order(lo, _lo_less, m, order, work)
+    for i in range(m):
+        k = order[i]
+        # the active segments (begun no later than k) that end before k begins end
+        # before every later one begins too: they leave; k meets the others' ranges
+        j = 0
+        for t in range(n_active):
+            q = active[t]
+            if hi[q] < lo[k]:
+                continue
+            active[j] = q
+            j += 1
+            tests += 1
+            if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
+                    or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
+                continue        # consecutive: a shared vertex index
+            if tests > cap or _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                                             &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
+                res = 0
                 break
         if res == 0:
             break
-    free(G.start)
-    free(G.item)
+        n_active = j
+        active[n_active] = k
+        n_active += 1
+    free(lo)
+    free(order)
     return res
 
 
