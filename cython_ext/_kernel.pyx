@@ -1125,12 +1125,16 @@ def ring_chains(const double[:, ::1] xy, const int64_t[::1] ring_of, Py_ssize_t 
 
 
 def rings_proved_valid(const double[:, ::1] pts, const int64_t[:, ::1] seg,
-                       const int64_t[::1] edge, const int64_t[::1] ring, Py_ssize_t n_rings):
+                       const int64_t[::1] edge, const int64_t[::1] ring,
+                       const int64_t[::1] first_ring):
     """Whether ring_chains' output (points, segments, input edge of each segment, ring
-    of each input edge) is proved a valid polygon, ring 0 its exterior: rings simple,
-    meeting nowhere, holes inside the exterior and outside each other (see
-    simple_rings.pxi).  False means not proved, not invalid."""
+    of each input edge) is proved a valid polygon or multipolygon, polygon k owning
+    rings first_ring[k] (its exterior) to first_ring[k + 1] - 1: rings simple, meeting
+    nowhere, holes inside their exterior and outside each other, a polygon inside
+    another only within a hole (see simple_rings.pxi).  False means not proved, not
+    invalid."""
     cdef Py_ssize_t n = pts.shape[0], m = seg.shape[0], k
+    cdef Py_ssize_t n_polys = first_ring.shape[0] - 1
     cdef int res
     if seg.shape[1] != 2 or pts.shape[1] != 2 or edge.shape[0] != m:
         raise ValueError("points and segments must have two columns, edges one per segment")
@@ -1138,13 +1142,15 @@ def rings_proved_valid(const double[:, ::1] pts, const int64_t[:, ::1] seg,
         if not (0 <= seg[k, 0] < n and 0 <= seg[k, 1] < n
                 and 0 <= edge[k] < ring.shape[0]):
             raise ValueError(f"segment {k} points outside the points or the edges")
-    if m == 0:
+    if m == 0 or n_polys < 1:
         return False
     if m >= NOGIL_MIN_ITEMS:
         with nogil:
-            res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m, n_rings)
+            res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m,
+                              &first_ring[0], n_polys)
     else:
-        res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m, n_rings)
+        res = rings_valid(&pts[0, 0], n, &seg[0, 0], &edge[0], &ring[0], m,
+                          &first_ring[0], n_polys)
     if res < 0:
         raise MemoryError("proving the rings valid")
     return res == 1

@@ -1,10 +1,12 @@
-# Whether a polygon's rings are a valid polygon, proved without GEOS: every ring simple
-# (at least three vertices, no two of its edges meeting but consecutive ones at their
-# common vertex, and those not folding back), no two rings meeting anywhere, and every
-# hole inside the exterior ring and outside the other holes.  Rings that meet nowhere
-# leave the interior connected, so such a polygon is valid in the OGC sense shapely and
-# GEOS use; what this cannot prove (rings touching at a point, which can be valid too,
-# or a search past its caps) is left to GEOS, which then also names what is wrong.
+# Whether a polygon's rings are a valid polygon (or a multipolygon's, a valid
+# multipolygon), proved without GEOS: every ring simple (at least three vertices, no two
+# of its edges meeting but consecutive ones at their common vertex, and those not
+# folding back), no two rings meeting anywhere, every hole inside its exterior ring and
+# outside its polygon's other holes, and a polygon inside another's exterior only within
+# one of its holes.  Rings that meet nowhere leave each interior connected, so such a
+# polygon is valid in the OGC sense shapely and GEOS use; what this cannot prove (rings
+# touching at a point, which can be valid too, or a search past its caps) is left to
+# GEOS, which then also names what is wrong.
 #
 # Two closed segments that meet overlap in x and in y, so a sweep along the longer side
 # of the points' box tests each segment, by exact orient2d, against the segments whose
@@ -21,10 +23,10 @@ from libc.stdlib cimport malloc, free
 # stabs a few segments of a drawn ring, but a comb of many parallel teeth would make
 # the sweep quadratic.
 cdef int64_t PROOF_TESTS_PER_SEGMENT = 64
-# The hole placement tests (holes times segments) allowed before leaving the proof to
-# GEOS: quadratic in the holes, so a polygon with thousands of holes is not looked at
-# hole by hole (GEOS's own index handles it).
-cdef int64_t HOLE_TESTS_MAX = 250_000
+# The placement tests (rings times segments) allowed before leaving the proof to GEOS:
+# quadratic in the rings, so a polygon with thousands of holes (or a multipolygon of
+# thousands of parts) is not looked at ring by ring (GEOS's own index handles it).
+cdef int64_t RING_TESTS_MAX = 250_000
 
 
 cdef inline bint _on_span(const double* a, const double* b, const double* c) noexcept nogil:
@@ -182,32 +184,63 @@ cdef bint _rings_fold_free(const double* xy, const int64_t* seg, const Py_ssize_
     return True
 
 
-cdef bint _holes_placed(const double* xy, const int64_t* seg, const Py_ssize_t* start,
-                        Py_ssize_t n_rings) noexcept nogil:
-    """Every hole (rings 1 on) inside the exterior (ring 0) and outside the other holes,
-    judged at its first vertex (the rings meet nowhere)."""
-    cdef Py_ssize_t r, q
+cdef bint _inside_any_hole(const double* xy, const int64_t* seg, const Py_ssize_t* start,
+                           Py_ssize_t h0, Py_ssize_t h1, Py_ssize_t skip,
+                           const double* p) noexcept nogil:
+    # p inside one of the rings h0..h1 - 1 but `skip`
+    cdef Py_ssize_t q
+    for q in range(h0, h1):
+        if q != skip and _inside_ring(xy, seg, start[q], start[q + 1], p):
+            return True
+    return False
+
+
+cdef bint _rings_placed(const double* xy, const int64_t* seg, const Py_ssize_t* start,
+                        const int64_t* first_ring, Py_ssize_t n_polys) noexcept nogil:
+    """Polygon k owns rings first_ring[k] (its exterior) to first_ring[k + 1] - 1 (its
+    holes).  Every hole inside its exterior and outside its polygon's other holes, and
+    every exterior inside another polygon's exterior only within one of its holes
+    (the interiors then do not overlap), each judged at the ring's first vertex (the
+    rings meet nowhere, so a ring is wholly inside or outside another)."""
+    cdef Py_ssize_t k, j, r, shell
     cdef const double* p
-    for r in range(1, n_rings):
-        p = &xy[2 * seg[2 * start[r]]]
-        if not _inside_ring(xy, seg, start[0], start[1], p):
-            return False
-        for q in range(1, n_rings):
-            if q != r and _inside_ring(xy, seg, start[q], start[q + 1], p):
+    for k in range(n_polys):
+        shell = first_ring[k]
+        for r in range(shell + 1, first_ring[k + 1]):
+            p = &xy[2 * seg[2 * start[r]]]
+            if not _inside_ring(xy, seg, start[shell], start[shell + 1], p):
+                return False
+            if _inside_any_hole(xy, seg, start, shell + 1, first_ring[k + 1], r, p):
+                return False
+        p = &xy[2 * seg[2 * start[shell]]]
+        for j in range(n_polys):
+            if j == k or not _inside_ring(xy, seg, start[first_ring[j]],
+                                          start[first_ring[j] + 1], p):
+                continue
+            if not _inside_any_hole(xy, seg, start, first_ring[j] + 1, first_ring[j + 1],
+                                    -1, p):
                 return False
     return True
 
 
 cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const int64_t* edge,
-                     const int64_t* ring, Py_ssize_t m, Py_ssize_t n_rings) noexcept nogil:
+                     const int64_t* ring, Py_ssize_t m, const int64_t* first_ring,
+                     Py_ssize_t n_polys) noexcept nogil:
     """1 when the rings (ring_chains_into's n points, m segments, the input edge of
-    each and the ring of each input edge; ring 0 the exterior) are proved a valid
-    polygon (see the top of this file), 0 when not proved, -1 when out of memory."""
+    each and the ring of each input edge) are proved the valid polygon, or the valid
+    multipolygon, whose polygon k owns rings first_ring[k] (its exterior) to
+    first_ring[k + 1] - 1 (see the top of this file); 0 when not proved, -1 when out
+    of memory."""
     cdef Py_ssize_t* start
+    cdef Py_ssize_t n_rings, k
     cdef int res
-    if n_rings < 1 or m < 3:
+    if n_polys < 1 or m < 3 or first_ring[0] != 0:
         return 0
-    if n_rings > 1 and (n_rings - 1) * m > HOLE_TESTS_MAX:
+    for k in range(n_polys):
+        if first_ring[k + 1] <= first_ring[k]:
+            return 0
+    n_rings = first_ring[n_polys]
+    if n_rings > 1 and (n_rings - 1) * m > RING_TESTS_MAX:
         return 0
     start = <Py_ssize_t*> malloc((n_rings + 1) * sizeof(Py_ssize_t))
     if start == NULL:
@@ -217,7 +250,7 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
         res = 0
     if res == 1:
         res = _no_contacts(xy, n, seg, m)
-    if res == 1 and not _holes_placed(xy, seg, start, n_rings):
+    if res == 1 and not _rings_placed(xy, seg, start, first_ring, n_polys):
         res = 0
     free(start)
     return res

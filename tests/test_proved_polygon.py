@@ -10,9 +10,10 @@ import math
 import numpy as np
 import pytest
 import shapely
+import shapely.affinity
 from hypothesis import given
 from hypothesis import strategies as st
-from shapely.geometry import Polygon, box
+from shapely.geometry import MultiPolygon, Polygon, box
 
 import aftmesh
 from aftmesh import _kernel, inputs
@@ -35,10 +36,11 @@ def assert_same_domain(a, b):
         assert x.dtype == y.dtype and np.array_equal(x, y), name
     for name in DOMAIN_FIELDS:
         assert getattr(a, name) == getattr(b, name), name
-    assert len(a.polygons) == len(b.polygons) == 1 and a.polygons[0] is b.polygons[0]
+    assert len(a.polygons) == len(b.polygons)
+    assert all(p.equals_exact(q, 0.0) for p, q in zip(a.polygons, b.polygons))
 
 
-def check_against_geos(poly: Polygon) -> bool:
+def check_against_geos(poly: Polygon | MultiPolygon) -> bool:
     """proved_polygon(poly), held to GEOS and to from_geometry; whether it proved."""
     proved = inputs.proved_polygon(poly)
     if proved is None:
@@ -65,6 +67,16 @@ def grid_polygons(draw):
 @given(grid_polygons())
 def test_what_the_kernel_proves_valid_geos_finds_valid(poly):
     check_against_geos(poly)
+
+
+@given(st.lists(grid_polygons(), min_size=1, max_size=3), st.lists(st.integers(0, 5)))
+def test_what_the_kernel_proves_a_valid_multipolygon_geos_finds_valid(polygons, shifts):
+    # parts moved apart by whole grid units: apart, touching, overlapping or nested
+    moved = [
+        shapely.affinity.translate(p, 2.0 * (shifts[k] if k < len(shifts) else 0), 0.0)
+        for k, p in enumerate(polygons)
+    ]
+    check_against_geos(MultiPolygon(moved))
 
 
 # A unit square, and a hole whose corners sit a few ulps from its edges or from each
@@ -120,6 +132,19 @@ PINNED = {
         False,
     ),
     "z values": (Polygon([(0, 0, 1), (4, 0, 1), (4, 4, 1), (0, 4, 1)]), False, True),
+    "two parts apart": (MultiPolygon([box(0, 0, 1, 1), box(2, 0, 3, 1)]), True, True),
+    "one part in a hole of the other": (
+        MultiPolygon(
+            [Polygon(SQUARE, [[(1, 1), (3, 1), (3, 3), (1, 3)]]), box(1.5, 1.5, 2.5, 2.5)]
+        ),
+        True,
+        True,
+    ),
+    "one part of a multipolygon": (MultiPolygon([Polygon(SQUARE)]), True, True),
+    "parts touching at a corner": (MultiPolygon([box(0, 0, 1, 1), box(1, 1, 2, 2)]), False, True),
+    "parts sharing an edge": (MultiPolygon([box(0, 0, 1, 1), box(1, 0, 2, 1)]), False, False),
+    "one part inside the other": (MultiPolygon([box(0, 0, 4, 4), box(1, 1, 2, 2)]), False, False),
+    "overlapping parts": (MultiPolygon([box(0, 0, 2, 2), box(1, 1, 3, 3)]), False, False),
 }
 
 
@@ -144,9 +169,19 @@ def test_valid_polygons_mesh_the_same_with_and_without_the_proof(name, monkeypat
 
 
 @pytest.mark.parametrize("name", [n for n, (_, _, valid) in PINNED.items() if not valid])
-def test_invalid_polygons_are_still_refused_with_geos_reasons(name):
-    with pytest.raises(InvalidDomainError, match="not a valid polygon"):
-        aftmesh.generate(PINNED[name][0], 0.5)
+def test_invalid_polygons_are_still_refused_or_merged_as_before(name, monkeypatch):
+    domain = PINNED[name][0]
+    if isinstance(domain, Polygon):
+        with pytest.raises(InvalidDomainError, match="not a valid polygon"):
+            aftmesh.generate(domain, 0.5)
+        return
+    # an invalid multipolygon's parts are merged by their union, as before
+    mesh = aftmesh.generate(domain, 0.5)
+    with monkeypatch.context() as m:
+        m.setattr(inputs, "proved_polygon", lambda p: None)
+        plain = aftmesh.generate(domain, 0.5)
+    assert np.array_equal(mesh.points, plain.points)
+    assert np.array_equal(mesh.triangles, plain.triangles)
 
 
 def test_a_polygon_with_many_holes_apart_is_proved_and_meshed(checked):
@@ -166,8 +201,9 @@ def test_rings_proved_valid_refuses_indices_outside_its_arrays():
     edge = np.arange(3, dtype=np.int64)
     ring = np.zeros(3, dtype=np.int64)
     good = np.array([[0, 1], [1, 2], [2, 0]], dtype=np.int64)
-    assert _kernel.rings_proved_valid(pts, good, edge, ring, 1)
+    one = np.array([0, 1], dtype=np.int64)
+    assert _kernel.rings_proved_valid(pts, good, edge, ring, one)
     with pytest.raises(ValueError, match="segment 2"):
-        _kernel.rings_proved_valid(pts, np.array([[0, 1], [1, 2], [2, 3]]), edge, ring, 1)
+        _kernel.rings_proved_valid(pts, np.array([[0, 1], [1, 2], [2, 3]]), edge, ring, one)
     with pytest.raises(ValueError, match="segment 0"):
-        _kernel.rings_proved_valid(pts, good, np.array([5, 1, 2]), ring, 1)
+        _kernel.rings_proved_valid(pts, good, np.array([5, 1, 2]), ring, one)

@@ -207,29 +207,41 @@ def _noded(
     )
 
 
-def proved_polygon(poly: Polygon) -> Domain | None:
-    """from_geometry(poly) for a lone Polygon whose rings the kernel proves a valid
-    polygon (rings_proved_valid: simple, meeting nowhere, holes in place), without
-    GEOS's validity check, which costs more than the rest of the conversion on a small
-    polygon; None when anything is not plainly fine (empty, z values, a coordinate
-    not finite or out of range, rings not proved), and from_geometry then decides,
-    with its messages.  The Domain is the one from_geometry makes."""
-    coords = shapely.get_coordinates(poly)
+def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
+    """from_geometry(domain) for a lone Polygon or MultiPolygon whose rings the kernel
+    proves valid (rings_proved_valid: simple, meeting nowhere, holes in place, parts
+    apart), without GEOS's validity check, which costs more than the rest of the
+    conversion on a small polygon; None when anything is not plainly fine (empty, z
+    values, a coordinate not finite or out of range, rings not proved), and
+    from_geometry then decides, with its messages.  The Domain is the one
+    from_geometry makes."""
+    coords = shapely.get_coordinates(domain)
     if (
         len(coords) == 0
-        or shapely.get_coordinate_dimension(poly) != 2
+        or shapely.get_coordinate_dimension(domain) != 2
         or coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE)
     ):
         return None
-    area = float(poly.area)
+    if type(domain) is Polygon:
+        polygons, names, area = [domain], ["the polygon"], float(domain.area)
+    else:
+        polygons = list(domain.geoms)
+        if len(polygons) == 1:
+            return proved_polygon(polygons[0])
+        if not (shapely.area(polygons) > 0).all():
+            return None
+        names = [f"polygon {k}" for k in range(len(polygons))]
+        area = float(MultiPolygon(polygons).area)  # as from_geometry's union has it
+        coords = None  # from_geometry reads the rings part by part
     if not area > 0:
         return None
     note: list[str] = []
-    rings = _ring_arrays([poly], ["the polygon"], note, coords)
-    pts, segs, edges, ring = rings[0], rings[1], rings[2], rings[3]
-    if not rings_proved_valid(pts, segs, edges, ring, len(rings[5])):
+    rings = _ring_arrays(polygons, names, note, coords)
+    first_ring = np.zeros(len(polygons) + 1, dtype=np.int64)
+    first_ring[1:] = np.cumsum(shapely.get_num_interior_rings(polygons) + 1)
+    if not rings_proved_valid(rings[0], rings[1], rings[2], rings[3], first_ring):
         return None
-    return _noded(rings, note, [poly], [], [], [], 0.0, True, area, apart=True)
+    return _noded(rings, note, polygons, [], [], [], 0.0, True, area, apart=True)
 
 
 def _split_geometry(domain):
@@ -380,7 +392,7 @@ def to_domain(
     splits them exactly); `tolerance` merges vertices closer than it and snaps line
     ends onto segments that near (0: exact); `repair` makes invalid polygons valid
     first (see :mod:`aftmesh.repair`).  What these changed is in ``Domain.report``."""
-    if type(domain) is Polygon and not repair and not tolerance > 0:
+    if type(domain) in (Polygon, MultiPolygon) and not repair and not tolerance > 0:
         proved = proved_polygon(domain)
         if proved is not None:
             return proved
