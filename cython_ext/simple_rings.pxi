@@ -61,22 +61,26 @@ cdef inline bint _folds_back(const double* a, const double* b, const double* c) 
     return (a[1] < b[1]) == (c[1] < b[1]) or c[1] == b[1]
 
 
-cdef bint _inside_ring(const double* xy, const int64_t* seg, Py_ssize_t s0, Py_ssize_t s1,
-                       const double* p) noexcept nogil:
-    """Whether p, on none of its edges, is inside the ring of segments s0..s1 - 1: the
-    parity of the edges crossing the ray from p towards +x (an edge counts when its
-    ends lie on either side of p's y, the upper one not below it)."""
+cdef int _inside_ring(const double* xy, const int64_t* seg, Py_ssize_t s0, Py_ssize_t s1,
+                      const double* p) noexcept nogil:
+    """Whether p is inside the ring of segments s0..s1 - 1: the parity of the edges
+    crossing the ray from p towards +x (an edge counts when one end lies above p's y
+    and the other not).  1 inside, 0 outside, -1 when p is on an edge (the rings
+    met after all: nothing is proved)."""
     cdef Py_ssize_t k
     cdef const double* a
     cdef const double* b
-    cdef bint inside = False
+    cdef int inside = 0, o
     for k in range(s0, s1):
         a = &xy[2 * seg[2 * k]]
         b = &xy[2 * seg[2 * k + 1]]
         if (a[1] > p[1]) != (b[1] > p[1]):
+            o = orient2d(a, b, p)
+            if o == 0:
+                return -1
             # p left of the edge taken upwards: the crossing is to p's right
-            if (orient2d(a, b, p) > 0) == (b[1] > a[1]):
-                inside = not inside
+            if (o > 0) == (b[1] > a[1]):
+                inside ^= 1
     return inside
 
 
@@ -184,15 +188,18 @@ cdef bint _rings_fold_free(const double* xy, const int64_t* seg, const Py_ssize_
     return True
 
 
-cdef bint _inside_any_hole(const double* xy, const int64_t* seg, const Py_ssize_t* start,
-                           Py_ssize_t h0, Py_ssize_t h1, Py_ssize_t skip,
-                           const double* p) noexcept nogil:
-    # p inside one of the rings h0..h1 - 1 but `skip`
+cdef int _inside_any_hole(const double* xy, const int64_t* seg, const Py_ssize_t* start,
+                          Py_ssize_t h0, Py_ssize_t h1, Py_ssize_t skip,
+                          const double* p) noexcept nogil:
+    # p inside one of the rings h0..h1 - 1 but `skip`: 1, 0, or -1 (on an edge)
     cdef Py_ssize_t q
+    cdef int inside
     for q in range(h0, h1):
-        if q != skip and _inside_ring(xy, seg, start[q], start[q + 1], p):
-            return True
-    return False
+        if q != skip:
+            inside = _inside_ring(xy, seg, start[q], start[q + 1], p)
+            if inside != 0:
+                return inside
+    return 0
 
 
 cdef bint _rings_placed(const double* xy, const int64_t* seg, const Py_ssize_t* start,
@@ -204,21 +211,24 @@ cdef bint _rings_placed(const double* xy, const int64_t* seg, const Py_ssize_t* 
     rings meet nowhere, so a ring is wholly inside or outside another)."""
     cdef Py_ssize_t k, j, r, shell
     cdef const double* p
+    cdef int inside
     for k in range(n_polys):
         shell = first_ring[k]
         for r in range(shell + 1, first_ring[k + 1]):
             p = &xy[2 * seg[2 * start[r]]]
-            if not _inside_ring(xy, seg, start[shell], start[shell + 1], p):
+            if _inside_ring(xy, seg, start[shell], start[shell + 1], p) != 1:
                 return False
-            if _inside_any_hole(xy, seg, start, shell + 1, first_ring[k + 1], r, p):
+            if _inside_any_hole(xy, seg, start, shell + 1, first_ring[k + 1], r, p) != 0:
                 return False
         p = &xy[2 * seg[2 * start[shell]]]
         for j in range(n_polys):
-            if j == k or not _inside_ring(xy, seg, start[first_ring[j]],
-                                          start[first_ring[j] + 1], p):
+            if j == k:
                 continue
-            if not _inside_any_hole(xy, seg, start, first_ring[j] + 1, first_ring[j + 1],
-                                    -1, p):
+            inside = _inside_ring(xy, seg, start[first_ring[j]], start[first_ring[j] + 1], p)
+            if inside == 0:
+                continue
+            if inside < 0 or _inside_any_hole(xy, seg, start, first_ring[j] + 1,
+                                              first_ring[j + 1], -1, p) != 1:
                 return False
     return True
 
