@@ -10,19 +10,19 @@
 #
 # Two closed segments that meet overlap in x and in y, so a sweep along the longer side
 # of the points' box tests each segment, by exact orient2d, against the segments whose
-# range along it overlaps its own: the ones the sweep line stabs, a few on the rings
-# people draw.  A hole's place is the crossing number of a ray from its first vertex,
-# by exact orient2d and exact comparisons of y: with the rings apart, the vertex lies
-# on no edge, so the count is never ambiguous.
+# range along it overlaps its own and whose box meets its box: the ones the sweep line
+# stabs, a few on the rings people draw.  A hole's place is the crossing number of a
+# ray from its first vertex, by exact orient2d and exact comparisons of y: with the
+# rings apart, the vertex lies on no edge, so the count is never ambiguous.
 #
-# Uses: inputs.pxi (box_of, stable_order); predicates.pxi (orient2d).
+# Uses: inputs.pxi (box_of); predicates.pxi (orient2d).
 from libc.stdint cimport int64_t
 from libc.stdlib cimport malloc, free
 
 # Segment pairs tested per segment before leaving the proof to GEOS: the sweep line
 # stabs a few segments of a drawn ring, but a comb of many parallel teeth would make
 # the sweep quadratic.
-cdef int64_t PROOF_TESTS_PER_SEGMENT = 64
+cdef int64_t PROOF_TESTS_PER_SEGMENT = 32
 # The placement tests (rings times segments) allowed before leaving the proof to GEOS:
 # quadratic in the rings, so a polygon with thousands of holes (or a multipolygon of
 # thousands of parts) is not looked at ring by ring (GEOS's own index handles it).
@@ -112,67 +112,96 @@ cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ri
     return 1
 
 
-cdef bint _lo_less(const void* data, Py_ssize_t i, Py_ssize_t j) noexcept nogil:
-    cdef const double* lo = <const double*> data
-    return lo[i] < lo[j]
+cdef inline Py_ssize_t _slab(double x, double base, double scale, Py_ssize_t last) noexcept nogil:
+    # the sweep's slab of coordinate x: a monotone function of x (a rounded
+    # subtraction, a product with a positive number, a truncation, a clamp), so that
+    # a range ending in an earlier slab than another begins ends before it
+    cdef double t = (x - base) * scale
+    if not t > 0.0:
+        return 0
+    if t >= last:
+        return last
+    return <Py_ssize_t> t
 
 
 cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
                       Py_ssize_t m) noexcept nogil:
     """1 when no two segments meet but consecutive ones of a ring at their shared end
     (which _rings_fold_free judges), 0 when two do or the sweep gives up past
-    PROOF_TESTS_PER_SEGMENT tests per segment, -1 when out of memory."""
-    cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis
+    PROOF_TESTS_PER_SEGMENT tests per segment, -1 when out of memory.  The sweep goes
+    along the box's longer side slab by slab (m slabs, segments in the slab their
+    range begins in, a counting sort); a segment leaves the active ones once the
+    slab its range ends in is behind."""
+    cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis, slab
     cdef int64_t tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
     cdef int res = 1
     cdef double box[4]
-    cdef double u, v
-    cdef double* lo = <double*> malloc(2 * m * sizeof(double))
-    cdef int64_t* order = <int64_t*> malloc(3 * m * sizeof(int64_t))
-    cdef double* hi
-    cdef int64_t* work
-    cdef int64_t* active
-    if lo == NULL or order == NULL:
-        free(lo)
-        free(order)
+    cdef double scale
+    cdef double* bb = <double*> malloc(4 * m * sizeof(double))
+    cdef Py_ssize_t* work = <Py_ssize_t*> malloc((4 * m + 1) * sizeof(Py_ssize_t))
+    cdef Py_ssize_t* first
+    cdef Py_ssize_t* order
+    cdef Py_ssize_t* ends
+    cdef Py_ssize_t* active
+    if bb == NULL or work == NULL:
+        free(bb)
+        free(work)
         return -1
-    hi = &lo[m]
-    work = &order[m]
-    active = &order[2 * m]
+    first = work                # m + 1 slab starts into order
+    order = &work[m + 1]
+    ends = &work[2 * m + 1]     # the slab each segment's range ends in
+    active = &work[3 * m + 1]
     box_of(xy, n, box)
     axis = 0 if box[2] - box[0] >= box[3] - box[1] else 1
+    scale = m / (box[2 + axis] - box[axis]) if box[2 + axis] > box[axis] else 0.0
+    for k in range(m):          # bb[4k..4k+3]: low and high along the axis, across it
+        for j in range(2):
+            bb[4 * k + 2 * j] = min(xy[2 * seg[2 * k] + (axis ^ j)],
+                                    xy[2 * seg[2 * k + 1] + (axis ^ j)])
+            bb[4 * k + 2 * j + 1] = max(xy[2 * seg[2 * k] + (axis ^ j)],
+                                        xy[2 * seg[2 * k + 1] + (axis ^ j)])
+    for i in range(m + 1):
+        first[i] = 0
     for k in range(m):
-        u = xy[2 * seg[2 * k] + axis]
-        v = xy[2 * seg[2 * k + 1] + axis]
-        lo[k] = min(u, v)
-        hi[k] = max(u, v)
-    stable_order(lo, _lo_less, m, order, work)
+        first[_slab(bb[4 * k], box[axis], scale, m - 1) + 1] += 1
+        ends[k] = _slab(bb[4 * k + 1], box[axis], scale, m - 1)
+    for i in range(m):
+        first[i + 1] += first[i]
+    for k in range(m):
+        slab = _slab(bb[4 * k], box[axis], scale, m - 1)
+        order[first[slab]] = k
+        first[slab] += 1
+    slab = 0
     for i in range(m):
         k = order[i]
-        # the active segments (begun no later than k) that end before k begins end
-        # before every later one begins too: they leave; k meets the others' ranges
+        while first[slab] <= i:     # after the placing pass, first[s] is slab s's end
+            slab += 1
         j = 0
         for t in range(n_active):
             q = active[t]
-            if hi[q] < lo[k]:
-                continue
+            if ends[q] < slab:
+                continue            # ends before every segment still to come begins
             active[j] = q
             j += 1
             tests += 1
+            if (bb[4 * q + 3] < bb[4 * k + 2] or bb[4 * k + 3] < bb[4 * q + 2]
+                    or bb[4 * q + 1] < bb[4 * k] or bb[4 * k + 1] < bb[4 * q]):
+                continue            # apart across the axis, or along it in one slab
             if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
                     or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
-                continue        # consecutive: a shared vertex index
-            if tests > cap or _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
-                                             &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
+                continue            # consecutive: a shared vertex index
+            if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                              &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
                 res = 0
                 break
-        if res == 0:
+        if res == 0 or tests > cap:
+            res = 0
             break
         n_active = j
         active[n_active] = k
         n_active += 1
-    free(lo)
-    free(order)
+    free(bb)
+    free(work)
     return res
 
 
