@@ -237,8 +237,11 @@ def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
         return None
     note: list[str] = []
     rings = _ring_arrays(polygons, names, note, coords)
-    first_ring = np.zeros(len(polygons) + 1, dtype=np.int64)
-    first_ring[1:] = np.cumsum(shapely.get_num_interior_rings(polygons) + 1)
+    if len(polygons) == 1:  # its rings are all the rings
+        first_ring = np.array((0, len(rings[5])), dtype=np.int64)
+    else:
+        first_ring = np.zeros(len(polygons) + 1, dtype=np.int64)
+        first_ring[1:] = np.cumsum(shapely.get_num_interior_rings(polygons) + 1)
     if not rings_proved_valid(rings[0], rings[1], rings[2], rings[3], first_ring):
         return None
     return _noded(rings, note, polygons, [], [], [], 0.0, True, area, apart=True)
