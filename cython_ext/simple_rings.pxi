@@ -138,9 +138,10 @@ cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
     cdef double box[4]
     cdef double scale
     cdef double* bb = <double*> malloc(4 * m * sizeof(double))
-    cdef Py_ssize_t* work = <Py_ssize_t*> malloc((4 * m + 1) * sizeof(Py_ssize_t))
+    cdef Py_ssize_t* work = <Py_ssize_t*> malloc((5 * m + 1) * sizeof(Py_ssize_t))
     cdef Py_ssize_t* first
     cdef Py_ssize_t* order
+    cdef Py_ssize_t* begins
     cdef Py_ssize_t* ends
     cdef Py_ssize_t* active
     if bb == NULL or work == NULL:
@@ -151,6 +152,7 @@ cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
     order = &work[m + 1]
     ends = &work[2 * m + 1]     # the slab each segment's range ends in
     active = &work[3 * m + 1]
+    begins = &work[4 * m + 1]   # the slab it begins in
     box_of(xy, n, box)
     axis = 0 if box[2] - box[0] >= box[3] - box[1] else 1
     scale = m / (box[2 + axis] - box[axis]) if box[2 + axis] > box[axis] else 0.0
@@ -163,14 +165,14 @@ cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
     for i in range(m + 1):
         first[i] = 0
     for k in range(m):
-        first[_slab(bb[4 * k], box[axis], scale, m - 1) + 1] += 1
+        begins[k] = _slab(bb[4 * k], box[axis], scale, m - 1)
         ends[k] = _slab(bb[4 * k + 1], box[axis], scale, m - 1)
+        first[begins[k] + 1] += 1
     for i in range(m):
         first[i + 1] += first[i]
     for k in range(m):
-        slab = _slab(bb[4 * k], box[axis], scale, m - 1)
-        order[first[slab]] = k
-        first[slab] += 1
+        order[first[begins[k]]] = k
+        first[begins[k]] += 1
     slab = 0
     for i in range(m):
         k = order[i]
