@@ -169,3 +169,123 @@ cdef void set_regions(Tri* T, const int32_t* comp, int ncomp,
             T.tstate[t] = T_EXTERIOR
         else:
             T.tregion[t] = r
+
+
+# Rings that meet nowhere nest: the outside, a part's interior, a hole in it, a part in
+# that hole, ...  A piece's depth there is found by this many sweeps over the segments
+# at most (each reaches at least one ring deeper); a deeper nest declines to the probes.
+cdef enum:
+    NESTING_MAX_SWEEPS = 64
+
+
+cdef int nested_regions(Tri* T, const int32_t* piece_edge, const int32_t* edge_source,
+                        const int32_t* ring_polygon) noexcept nogil:
+    """The regions of the pieces of a valid multipolygon whose rings meet nowhere
+    (inputs.proved_polygon proves it): every segment then has the inside on one side
+    and not on the other, so a piece is inside exactly when an odd number of rings
+    separates it from the outside, which the carve from the hull left exterior; its
+    region is the polygon of the rings around it (ring_polygon, by source: the
+    segment's input edge piece_edge, that edge's source edge_source).  Holes and the
+    pieces in them get -1.  Returns 1 when it set the regions, 0 when the pieces do not
+    nest so (a segment with one piece on both sides or on both sides the same parity,
+    an inside piece within two polygons' rings, a piece not reached within
+    NESTING_MAX_SWEEPS): the stages then classify by probes; or an error."""
+    cdef int t, nc, res = 1
+    cdef int n = T.nt if T.nt > 0 else 1
+    cdef int32_t* comp = <int32_t*> malloc(n * sizeof(int32_t))
+    cdef int32_t* best = <int32_t*> malloc(n * sizeof(int32_t))
+    cdef int32_t* sides = <int32_t*> malloc(3 * n * sizeof(int32_t))
+    cdef int32_t* region = NULL
+    cdef int8_t* odd = NULL
+    if comp == NULL or best == NULL or sides == NULL:
+        res = ERR_NOMEM
+    else:
+        for t in range(T.nt):
+            comp[t] = -1
+        nc = domain_components(T, comp, best)
+        if nc < 0:
+            res = nc
+        else:
+            region = <int32_t*> malloc((nc if nc > 0 else 1) * sizeof(int32_t))
+            odd = <int8_t*> malloc(nc if nc > 0 else 1)
+            if region == NULL or odd == NULL:
+                res = ERR_NOMEM
+            else:
+                res = _nest(T, comp, nc, sides, odd)
+                if res > 0:
+                    res = _regions_of_odd(T, comp, nc, sides, odd, piece_edge, edge_source,
+                                          ring_polygon, region)
+                if res > 0:
+                    set_regions(T, comp, T.nt, region)
+    free(comp)
+    free(best)
+    free(sides)
+    free(region)
+    free(odd)
+    return res
+
+
+cdef int _nest(Tri* T, const int32_t* comp, int nc, int32_t* sides,
+               int8_t* odd) noexcept nogil:
+    """odd[c]: the parity of the rings between piece c and the outside (see
+    nested_regions); sides gets the segment half-edges of domain triangles, ended by
+    -1.  Returns 1, or 0 where the pieces do not nest."""
+    cdef int e, f, a, b, k, ns = 0, sweep
+    cdef bint changed = True
+    for a in range(nc):
+        odd[a] = -1
+    for e in range(3 * T.nt):
+        if not T.eflag[e] & E_SEGMENT or T.tstate[e // 3] != T_UNMESHED:
+            continue
+        sides[ns] = e
+        ns += 1
+        if T.tstate[T.twin[e] // 3] != T_UNMESHED:
+            odd[comp[e // 3]] = 1           # across the segment: the carved outside
+    sides[ns] = -1
+    sweep = 0
+    while changed:
+        if sweep == NESTING_MAX_SWEEPS:
+            return 0
+        sweep += 1
+        changed = False
+        for k in range(ns):
+            e = sides[k]
+            f = T.twin[e]
+            if T.tstate[f // 3] != T_UNMESHED:
+                continue
+            a = comp[e // 3]
+            b = comp[f // 3]
+            if a == b or (odd[a] >= 0 and odd[a] == odd[b]):
+                return 0
+            if odd[a] >= 0 and odd[b] < 0:
+                odd[b] = 1 - odd[a]
+                changed = True
+    for a in range(nc):
+        if odd[a] < 0:
+            return 0
+    return 1
+
+
+cdef int _regions_of_odd(Tri* T, const int32_t* comp, int nc, const int32_t* sides,
+                         const int8_t* odd, const int32_t* piece_edge,
+                         const int32_t* edge_source, const int32_t* ring_polygon,
+                         int32_t* region) noexcept nogil:
+    """region[c]: the polygon of the rings around each odd piece c (they must agree),
+    -1 for the even ones.  Returns 1, or 0 where they disagree."""
+    cdef int k, c, r
+    for c in range(nc):
+        region[c] = -1
+    k = 0
+    while sides[k] >= 0:
+        c = comp[sides[k] // 3]
+        k += 1
+        if not odd[c]:
+            continue
+        r = ring_polygon[edge_source[piece_edge[T.eseg[sides[k - 1]]]]]
+        if region[c] >= 0 and region[c] != r:
+            return 0
+        region[c] = r
+    for c in range(nc):
+        if odd[c] and region[c] < 0:
+            return 0
+    return 1

@@ -180,6 +180,18 @@ cdef int _inside_exterior(Tri* T, const int32_t* piece_edge,
     return res
 
 
+cdef void _check_ring_polygon(const int32_t[::1] edge_source,
+                              const int32_t[::1] ring_polygon, bint classify) except *:
+    """generate_common's ring_polygon names a polygon for every source of edge_source."""
+    cdef Py_ssize_t i, k = ring_polygon.shape[0]
+    if not classify:
+        raise ValueError("ring_polygon classifies pieces: classify must be set with it")
+    for i in range(edge_source.shape[0]):
+        if not 0 <= edge_source[i] < k:
+            raise ValueError(f"edge_source[{i}] = {edge_source[i]} names no ring of "
+                             f"ring_polygon (length {k})")
+
+
 cdef double _clock() noexcept nogil:
     """time.perf_counter() (CLOCK_MONOTONIC on Linux, in seconds), without the GIL."""
     cdef timespec ts
@@ -201,6 +213,7 @@ cdef struct Pieces:
     int m
     const int32_t* piece_edge   # NULL: no classification (no holes)
     const int32_t* edge_source
+    const int32_t* ring_polygon # not NULL: the pieces nest (domain.pxi's nested_regions)
     long long max_triangles
     int first_movable
     int n_corner                # input vertices: the split points after them slide
@@ -224,7 +237,11 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
         return PIECES_INSERT_FAILED
     if P.through:
         return PIECES_DECLINED
-    if P.piece_edge != NULL:
+    if P.ring_polygon != NULL:
+        P.res = nested_regions(T, P.piece_edge, P.edge_source, P.ring_polygon)
+        if P.res <= 0:
+            return PIECES_DECLINED if P.res == 0 else PIECES_RAN
+    elif P.piece_edge != NULL:
         P.res = _inside_exterior(T, P.piece_edge, P.edge_source)
         if P.res <= 0:
             return PIECES_DECLINED if P.res == 0 else PIECES_RAN
@@ -247,9 +264,9 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
 
 cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               const int32_t[:, ::1] seg, object piece_edge,
-                              const int32_t[::1] edge_source, long long max_triangles,
-                              int smooth_rounds, bint slide, double min_angle,
-                              int n_corners):
+                              const int32_t[::1] edge_source, object ring_polygon,
+                              long long max_triangles, int smooth_rounds, bint slide,
+                              double min_angle, int n_corners):
     """_mesh_pieces on tri (its size field and options set), with the def layer's
     error handling: None where the stages must run, else (merged vertices, smoothing
     moves, the refine pass's counts or None, t_cdt, t_aft)."""
@@ -257,6 +274,7 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
     cdef Refine R
     cdef int outcome, nv = tri.T.nv
     cdef const int32_t[::1] pe
+    cdef const int32_t[::1] rp
     memset(&P, 0, sizeof(Pieces))
     P.m = seg.shape[0]
     P.rounds = &rounds[0] if nv else NULL
@@ -265,6 +283,9 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
         pe = piece_edge
         P.piece_edge = &pe[0]
         P.edge_source = &edge_source[0]
+        if ring_polygon is not None:
+            rp = ring_polygon
+            P.ring_polygon = &rp[0]
     P.max_triangles = max_triangles
     P.first_movable = nv
     P.n_corner = n_corners if slide else -1
@@ -301,7 +322,7 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
 
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
                     const int32_t[::1] source, const int32_t[::1] edge_source,
-                    bint classify, double constant, double gradation,
+                    bint classify, object ring_polygon, double constant, double gradation,
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
@@ -309,7 +330,9 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     """The stages of generate from the size field to the refined mesh, for a number
     size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
-    the exterior ring source 0.  rounds: _order.round_keys, called for the BRIO
+    the exterior ring source 0; or, with ring_polygon (an int32 array: the polygon of
+    each source ring), a valid multipolygon whose rings meet nowhere, its pieces
+    classified by how they nest (domain.pxi's nested_regions).  rounds: _order.round_keys, called for the BRIO
     round keys of the background's and the boundary's points; max_pieces: the most
     boundary pieces allowed; progress_limit: the triangle hint above which a progress
     bar may be wanted; slide: smoothing slides the boundary's split points along
@@ -329,6 +352,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
             or not (gradation >= 1.0 and isfinite(gradation))):
         return None
     _check_pslg(vertices, segments)
+    if ring_polygon is not None:
+        _check_ring_polygon(edge_source, ring_polygon, classify)
     box_of(&vertices[0, 0], n, box)
     res = _math_ulp(max(max(fabs(box[0]), fabs(box[1])), max(fabs(box[2]), fabs(box[3]))))
     if not constant >= rules[RULE_MIN_SIZE_ULPS] * res:
@@ -353,7 +378,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     memset(&S, 0, sizeof(SizeField))
     try:
         return _generate_on(&S, field, vertices, segments, source, edge_source, classify,
-                            constant, area, rules, rounds, max_pieces, progress_limit,
+                            ring_polygon, constant, area, rules, rounds, max_pieces, progress_limit,
                             order, max_triangles, min_area, close_factor, swaps, greedy,
                             smooth_rounds, slide, min_angle, scaffold, n)
     finally:
@@ -362,7 +387,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
 
 cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertices,
                          const int32_t[:, ::1] segments, const int32_t[::1] source,
-                         const int32_t[::1] edge_source, bint classify, double constant,
+                         const int32_t[::1] edge_source, bint classify,
+                         object ring_polygon, double constant,
                          double area, const double[::1] rules, object rounds,
                          double max_pieces, double progress_limit, int order,
                          long long max_triangles, object min_area, double close_factor,
@@ -413,8 +439,8 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
                     close_factor=close_factor, swaps=swaps, greedy=greedy,
                     scaffold=scaffold)
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
-                            e_out if classify else None, edge_source, max_triangles,
-                            smooth_rounds, slide, min_angle, n)
+                            e_out if classify else None, edge_source, ring_polygon,
+                            max_triangles, smooth_rounds, slide, min_angle, n)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

@@ -282,6 +282,28 @@ def star_polygons(draw, max_vertices=16):
 
 
 @st.composite
+def nested_multipolygons(draw, max_depth=4):
+    """Multipolygons whose rings meet nowhere: a star polygon and copies of it scaled
+    about its centre, alternately a part's exterior and a hole (islands in lakes in
+    islands, the innermost island with or without a lake), and maybe a second such
+    nest beside the first."""
+    star = draw(star_polygons())
+    parts = []
+    for dx in (0.0, 2.5)[: draw(st.integers(1, 2))]:
+        depth = draw(st.integers(1, max_depth))
+        n = 2 * depth - 1 + draw(st.integers(0, 1))  # rings in this nest
+        scales = sorted(draw(st.lists(st.floats(0.1, 1.0), min_size=n, max_size=n)))[::-1]
+        assume(all(a - b > 0.05 for a, b in zip(scales, scales[1:])))
+        rings = [shapely.affinity.scale(star, f, f, origin=(0, 0)).exterior.coords for f in scales]
+        for k in range(0, n, 2):
+            part = Polygon(rings[k], rings[k + 1 : k + 2])
+            parts.append(shapely.affinity.translate(part, dx, 0.0))
+    multi = MultiPolygon(parts)
+    assume(multi.is_valid)
+    return multi
+
+
+@st.composite
 def polygons_with_circular_holes(draw, max_holes=5):
     """The square [0, 2]^2 minus disjoint discs (as polygons) well inside it."""
     k = draw(st.integers(1, max_holes))

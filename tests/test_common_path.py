@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import shapely
 from domain_cases import (
+    nested_multipolygons,
     polygons_with_circular_holes,
     shapely_cases,
     star_polygons,
@@ -15,10 +16,11 @@ from domain_cases import (
 )
 from hypothesis import given
 from hypothesis import strategies as st
-from shapely.geometry import Polygon, box
+from shapely.geometry import MultiPolygon, Polygon, box
 
 import aftmesh
 import aftmesh._common as common
+from aftmesh import inputs
 from aftmesh.errors import InvalidSizeError
 
 MESH_ARRAYS = ("points", "triangles", "neighbors", "segments", "regions")
@@ -234,3 +236,73 @@ def test_common_case_classifies_holes_touching_the_exterior_and_each_other(monke
     )
     assert touching.is_valid
     assert _compare(monkeypatch, touching, 0.2, checked).taken == 1
+
+
+def _region_areas(mesh) -> np.ndarray:
+    p, t = mesh.points, mesh.triangles
+    a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
+    area = 0.5 * ((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+    return np.bincount(mesh.regions, weights=area)
+
+
+# islands in lakes in islands, beside a square apart: four parts, each its own region
+LAKES = MultiPolygon(
+    [
+        Polygon([(0, 0), (10, 0), (10, 10), (0, 10)], [[(2, 2), (8, 2), (8, 8), (2, 8)]]),
+        Polygon([(3, 3), (7, 3), (7, 7), (3, 7)], [[(4, 4), (6, 4), (6, 6), (4, 6)]]),
+        box(4.5, 4.5, 5.5, 5.5),
+        box(12, 0, 13, 1),
+    ]
+)
+
+
+def test_common_case_gives_nested_parts_the_regions_the_probes_give(monkeypatch, checked):
+    taken = _compare(monkeypatch, LAKES, 0.4, checked)
+    assert taken.taken == 1
+    mesh = aftmesh.generate(LAKES, 0.4)
+    assert np.allclose(_region_areas(mesh), [g.area for g in LAKES.geoms], rtol=1e-12)
+
+
+@given(nested_multipolygons(), st.sampled_from([0.05, 0.2]))
+def test_common_case_makes_the_stages_mesh_on_nested_multipolygons(multi, size):
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        taken = _compare(monkeypatch, multi, size)
+    assert taken.taken + taken.declined == 1
+    if inputs.proved_polygon(multi) is not None:
+        assert taken.taken == 1
+
+
+def test_common_case_declines_pieces_that_do_not_nest_as_said(monkeypatch, checked):
+    # a Domain whose ring_polygon puts a polygon's hole in another polygon: the
+    # piece between the two rings is bounded by two polygons' rings, so the compiled
+    # call declines and the stages classify by probes
+    holed = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], [[(1, 1), (3, 1), (3, 3), (1, 3)]])
+    beside = box(5, 0, 6, 1)
+    multi = MultiPolygon([holed, beside])
+    proved = inputs.proved_polygon
+
+    def mislabelled(domain):
+        dom = proved(domain)
+        dom.ring_polygon = np.array([0, 1, 1], dtype=np.int32)
+        return dom
+
+    monkeypatch.setattr(inputs, "proved_polygon", mislabelled)
+    taken = _compare(monkeypatch, multi, 0.5, checked)
+    assert taken.declined == 1 and taken.taken == 0
+
+
+def test_generate_common_refuses_a_ring_polygon_that_misses_a_source():
+    from aftmesh._kernel import generate_common
+
+    ring = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
+    segments = np.array([[0, 1], [1, 2], [2, 3], [3, 0]], dtype=np.int32)
+    source = np.arange(4, dtype=np.int32)
+    edge_source = np.array([0, 0, 0, 1], dtype=np.int32)
+    # size, gradation, area, round keys, rules, most pieces, progress limit, order,
+    # max_triangles, min_area, close_factor; swaps, greedy, smoothing rounds, slides,
+    # min_angle, scaffold
+    numbers = (0.5, 1.5, 1.0, None, common._RULES, 100.0, 1e9, 0, -1, None, 0.5)
+    switches = (True, False, 3, True, 0.0, False)
+    wrong = np.zeros(1, dtype=np.int32)  # one ring, but edge 3 is of source 1
+    with pytest.raises(ValueError, match=r"edge_source\[3\] = 1 names no ring"):
+        generate_common(ring, segments, source, edge_source, True, wrong, *numbers, *switches)

@@ -71,8 +71,8 @@ def _is_plain_number(size) -> bool:
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size, the
     compiled subtasks with split input edges, no progress bar asked for, and one
-    polygon (holes allowed, no constraint lines) or a dict or .poly without holes or
-    region points."""
+    polygon (holes allowed, no constraint lines), polygons whose rings meet nowhere,
+    or a dict or .poly without holes or region points."""
     return (
         _is_plain_number(size)
         and opts.compiled
@@ -80,7 +80,7 @@ def applies(dom: Domain, size, opts: Options) -> bool:
         and (opts.progress is None or opts.progress is False)
         and (dom.holes is None or len(dom.holes) == 0)
         and (dom.region_points is None or len(dom.region_points) == 0)
-        and (dom.polygons is None or _one_polygon_of_rings(dom))
+        and (dom.polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom))
     )
 
 
@@ -92,6 +92,12 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
     return (
         len(polygons) == 1 and type(polygons[0]) is Polygon and dom.n_rings == len(dom.source_names)
     )
+
+
+def _nested_rings(dom: Domain) -> bool:
+    """Polygons whose rings are all the sources and are proved to meet nowhere: their
+    pieces are classified by how they nest (domain.pxi's nested_regions)."""
+    return dom.ring_polygon is not None and dom.n_rings == len(dom.source_names)
 
 
 def _progress_limit(progress) -> float:
@@ -110,7 +116,8 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         np.ascontiguousarray(dom.segments, dtype=np.int32),
         np.ascontiguousarray(dom.segment_edge, dtype=np.int32),
         np.ascontiguousarray(dom.edge_source, dtype=np.int32),
-        dom.polygons is not None and dom.n_rings > 1,  # holes: pieces to classify
+        dom.polygons is not None and dom.n_rings > 1,  # holes or parts: pieces to classify
+        dom.ring_polygon,
         float(size),
         float(opts.gradation),
         float(dom.area or 0.0),

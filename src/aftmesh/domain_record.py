@@ -82,6 +82,9 @@ class Domain:
     edge_midpoints: np.ndarray | None = None  # (e, 2) the midpoint of each input edge
     report: dict = field(default_factory=dict)  # what repair / tolerance changed
     n_rings: int = 0  # the sources numbered first that are polygon rings (shapely input)
+    # the polygon each ring bounds, where the rings are proved to meet nowhere
+    # (inputs.proved_polygon): the compiled call then classifies the pieces by nesting
+    ring_polygon: np.ndarray | None = None
 
     @property
     def segment_source(self) -> np.ndarray:

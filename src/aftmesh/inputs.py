@@ -177,9 +177,11 @@ def _noded(
     valid: bool,
     area: float | None,
     apart: bool = False,
+    ring_polygon: np.ndarray | None = None,
 ) -> Domain:
     """_from_shapely's Domain from the rings' arrays (_ring_arrays); `apart`: the
-    rings are known to meet nowhere (see merge_and_node)."""
+    rings are known to meet nowhere (see merge_and_node), ring_polygon: then the
+    polygon of each ring, for the Domain."""
     n_rings = len(rings[5])
     verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
     edge_source = source.astype(np.int32)
@@ -204,6 +206,7 @@ def _noded(
         edge_midpoints=mids,
         report={"tolerance": report} if report else {},
         n_rings=n_rings,
+        ring_polygon=ring_polygon,
     )
 
 
@@ -231,20 +234,27 @@ def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
         if not (shapely.area(polygons) > 0).all():
             return None
         names = [f"polygon {k}" for k in range(len(polygons))]
-        area = float(MultiPolygon(polygons).area)  # as from_geometry's union has it
+        # from_geometry's union of a valid multipolygon's parts is MultiPolygon(parts):
+        # this geometry, whose area GEOS sums part by part in the same order
+        area = float(domain.area)
         coords = None  # from_geometry reads the rings part by part
     if not area > 0:
         return None
     note: list[str] = []
     rings = _ring_arrays(polygons, names, note, coords)
+    ring_polygon = None
     if len(polygons) == 1:  # its rings are all the rings
         first_ring = np.array((0, len(rings[5])), dtype=np.int64)
     else:
+        per_polygon = shapely.get_num_interior_rings(polygons) + 1
         first_ring = np.zeros(len(polygons) + 1, dtype=np.int64)
-        first_ring[1:] = np.cumsum(shapely.get_num_interior_rings(polygons) + 1)
+        first_ring[1:] = np.cumsum(per_polygon)
+        ring_polygon = np.repeat(np.arange(len(polygons), dtype=np.int32), per_polygon)
     if not rings_proved_valid(rings[0], rings[1], rings[2], rings[3], first_ring):
         return None
-    return _noded(rings, note, polygons, [], [], [], 0.0, True, area, apart=True)
+    return _noded(
+        rings, note, polygons, [], [], [], 0.0, True, area, apart=True, ring_polygon=ring_polygon
+    )
 
 
 def _split_geometry(domain):
