@@ -485,22 +485,12 @@ cdef class Triangulation:
         lies on a segment or on a vertex that a segment ends at (it then belongs to no
         single region)."""
         cdef double p[2]
-        cdef int where = NONE, loc
+        cdef int state
         p[0] = x
         p[1] = y
-        loc = locate(&self.T, p, NONE, &where)
-        _raise_for(&self.T, loc)
-        if loc == LOC_IN_TRIANGLE:
-            return self.T.tstate[where]
-        if loc == LOC_ON_EDGE:
-            if self.T.eflag[where] & E_SEGMENT:
-                return None
-            return self.T.tstate[where // 3]
-        if loc == LOC_ON_VERTEX:
-            if _vertex_on_segment(&self.T, where):
-                return None
-            return self.T.tstate[self.T.vhe[where] // 3]
-        return T_EXTERIOR
+        state = seed_state(&self.T, p)
+        _raise_for(&self.T, state)
+        return None if state == SEED_ON_SEGMENT else state
 
     def state_counts(self):
         """Number of triangles in each state: (exterior incl. ghosts, unmeshed, meshed)."""

@@ -58,6 +58,27 @@ cdef int _seed_triangle(Tri* T, int loc, int where) noexcept nogil:
     return NONE
 
 
+cdef enum:
+    SEED_ON_SEGMENT = 255   # seed_state: the point lies on a segment (no tstate value)
+
+
+cdef int seed_state(Tri* T, const double* p) noexcept nogil:
+    """The state of the triangle holding p (T_EXTERIOR outside the hull), or
+    SEED_ON_SEGMENT when p lies on a segment or on a vertex that a segment ends at (it
+    belongs to no single region): what a hole or region point is checked by.  Returns
+    an error when the walk fails."""
+    cdef int where = NONE, loc = locate(T, p, NONE, &where)
+    if loc < 0:
+        return loc
+    if loc == LOC_IN_TRIANGLE:
+        return T.tstate[where]
+    if loc == LOC_ON_EDGE:
+        return SEED_ON_SEGMENT if T.eflag[where] & E_SEGMENT else T.tstate[where // 3]
+    if loc == LOC_ON_VERTEX:
+        return SEED_ON_SEGMENT if _vertex_on_segment(T, where) else T.tstate[T.vhe[where] // 3]
+    return T_EXTERIOR
+
+
 # ---------------------------------------------------------------- the domain
 
 cdef int carve_domain(Tri* T, const double* holes, int nholes, bint from_hull) noexcept nogil:

@@ -1,6 +1,6 @@
-# generate's common case in one call: one polygon (holes allowed) or a domain without
-# holes, region points or regions, meshed at a constant size with the compiled
-# subtasks.
+# generate's common case in one call: one polygon (holes allowed), polygons whose
+# rings meet nowhere, or a dict or .poly domain (with Triangle's hole and region
+# points or without), meshed at a constant size with the compiled subtasks.
 #
 # It is the data flow of _stages.py (size field, count, discretization, boundary CDT,
 # front, smoothing, minimum-angle pass) with the glue between the kernel calls in C
@@ -80,8 +80,9 @@ cdef object _round_keys_of(object round_keys, Py_ssize_t n):
 cdef object _common_field(const double[:, ::1] v, const double* box, double res,
                           double constant, double gradation, const double* short,
                           const double[::1] rules, object rounds):
-    """make_size_field of a number on these vertices and shortest edges (res: the
-    spacing of doubles at the largest coordinate): None for a constant field, False
+    """make_size_field of a number (0: size=None, the input edges alone) on these
+    vertices and shortest edges (res: the spacing of doubles at the largest
+    coordinate): None for a constant field, False
     where the stages would raise, else the SizeField's arrays (points, user, graded,
     triangles, neighbours, rate, reach)."""
     cdef Py_ssize_t n = v.shape[0], i, nb4 = n + 4
@@ -89,10 +90,11 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     for i in range(n):
         if short[i] < c_min:
             c_min = short[i]
-    if c_min >= rules[RULE_CONSTANT_IF_EDGES_ABOVE] * constant:
+    if constant > 0 and c_min >= rules[RULE_CONSTANT_IF_EDGES_ABOVE] * constant:
         return None
+    cdef double user = constant if constant > 0 else INFINITY
     pts_arr = np.empty((nb4, 2), dtype=np.float64)
-    u_arr = np.full(nb4, constant)
+    u_arr = np.full(nb4, user)
     g_arr = np.empty(nb4, dtype=np.float64)
     cdef double* pts = _f64v(pts_arr)
     cdef double* g = _f64v(g_arr)
@@ -113,7 +115,7 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     spread = gradation if gradation > 1.0 else rules[RULE_DEFAULT_GRADATION]
     for i in range(nb4):
         length = (short[i] if short[i] >= floor else floor) if i < n else INFINITY
-        g[i] = (constant if constant <= length else length) if gradation > 1.0 else length
+        g[i] = (user if user <= length else length) if gradation > 1.0 else length
     tv, nb, finite = background_field(pts_arr, _round_keys_of(rounds, nb4), g_arr,
                                       spread - 1.0)
     if not finite:
@@ -213,7 +215,12 @@ cdef struct Pieces:
     int m
     const int32_t* piece_edge   # NULL: no classification (no holes)
     const int32_t* edge_source
-    const int32_t* ring_polygon # not NULL: the pieces nest (domain.pxi's nested_regions)
+    const int32_t* ring_polygon  # not NULL: the pieces nest (domain.pxi's nested_regions)
+    const double* holes         # Triangle's hole points (2 per hole)
+    int n_holes
+    const double* seeds         # Triangle's region points (2 each) and their ids
+    const int32_t* seed_ids
+    int n_seeds
     long long max_triangles
     int first_movable
     int n_corner                # input vertices: the split points after them slide
@@ -237,6 +244,10 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
         return PIECES_INSERT_FAILED
     if P.through:
         return PIECES_DECLINED
+    if P.n_holes or P.n_seeds:
+        P.res = _carve_and_seed(T, P)
+        if P.res <= 0:
+            return PIECES_DECLINED if P.res == 0 else PIECES_RAN
     if P.ring_polygon != NULL:
         P.res = nested_regions(T, P.piece_edge, P.edge_source, P.ring_polygon)
         if P.res <= 0:
@@ -262,11 +273,37 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
     return PIECES_RAN
 
 
+cdef int _carve_and_seed(Tri* T, const Pieces* P) noexcept nogil:
+    """pslg.build_cdt's hole and region points, in its order: each point checked
+    inside the domain and off the segments (seed_state), the holes carved, the
+    regions flooded.  Returns 1, 0 where a point fails its check (the stages then
+    raise, naming it), or an error."""
+    cdef int i, state, res
+    for i in range(P.n_holes + P.n_seeds):
+        state = seed_state(T, &P.holes[2 * i] if i < P.n_holes
+                           else &P.seeds[2 * (i - P.n_holes)])
+        if state < 0:
+            return state
+        if state != T_UNMESHED:
+            return 0
+    if P.n_holes:
+        res = carve_domain(T, P.holes, P.n_holes, False)
+        if res < 0:
+            return res
+    if P.n_seeds:
+        res = assign_regions(T, P.seeds, P.seed_ids, P.n_seeds)
+        if res < 0:
+            return res
+    return 1
+
+
 cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               const int32_t[:, ::1] seg, object piece_edge,
                               const int32_t[::1] edge_source, object ring_polygon,
-                              long long max_triangles, int smooth_rounds, bint slide,
-                              double min_angle, int n_corners):
+                              const double[:, ::1] holes, const double[:, ::1] seeds,
+                              const int32_t[::1] seed_ids, long long max_triangles,
+                              int smooth_rounds, bint slide, double min_angle,
+                              int n_corners):
     """_mesh_pieces on tri (its size field and options set), with the def layer's
     error handling: None where the stages must run, else (merged vertices, smoothing
     moves, the refine pass's counts or None, t_cdt, t_aft)."""
@@ -286,6 +323,11 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
         if ring_polygon is not None:
             rp = ring_polygon
             P.ring_polygon = &rp[0]
+    P.n_holes = holes.shape[0]
+    P.holes = &holes[0, 0] if P.n_holes else NULL
+    P.n_seeds = seeds.shape[0]
+    P.seeds = &seeds[0, 0] if P.n_seeds else NULL
+    P.seed_ids = &seed_ids[0] if P.n_seeds else NULL
     P.max_triangles = max_triangles
     P.first_movable = nv
     P.n_corner = n_corners if slide else -1
@@ -322,21 +364,26 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
 
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
                     const int32_t[::1] source, const int32_t[::1] edge_source,
-                    bint classify, object ring_polygon, double constant, double gradation,
+                    bint classify, object ring_polygon, const double[:, ::1] holes,
+                    const double[:, ::1] seeds, const int32_t[::1] seed_ids,
+                    double constant, double gradation,
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
                     int smooth_rounds, bint slide, double min_angle, bint scaffold):
     """The stages of generate from the size field to the refined mesh, for a number
-    size (see the top of pipeline.pxi).  classify: the domain is one valid polygon
+    size, `constant` (0: size=None, the input edges' lengths alone; see the top of
+    pipeline.pxi).  classify: the domain is one valid polygon
     with holes, its rings the sources (edge_source: the source of each input edge),
     the exterior ring source 0; or, with ring_polygon (an int32 array: the polygon of
     each source ring), a valid multipolygon whose rings meet nowhere, its pieces
-    classified by how they nest (domain.pxi's nested_regions).  rounds: _order.round_keys, called for the BRIO
-    round keys of the background's and the boundary's points; max_pieces: the most
-    boundary pieces allowed; progress_limit: the triangle hint above which a progress
-    bar may be wanted; slide: smoothing slides the boundary's split points along
-    their input edges; min_angle 0: no pass.
+    classified by how they nest (domain.pxi's nested_regions).  holes, seeds and
+    seed_ids: Triangle's hole points and region points with their ids ((0, 2), (0, 2)
+    and (0,) for none), as pslg.build_cdt applies them.  rounds: _order.round_keys,
+    called for the BRIO round keys of the background's and the boundary's points;
+    max_pieces: the most boundary pieces allowed; progress_limit: the triangle hint
+    above which a progress bar may be wanted; slide: smoothing slides the boundary's
+    split points along their input edges; min_angle 0: no pass.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
@@ -348,15 +395,22 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     cdef SizeField S
     if rules.shape[0] != N_RULES:
         raise ValueError(f"rules must hold {N_RULES} values")
-    if (m == 0 or n < 3 or source.shape[0] != m or not (constant > 0 and isfinite(constant))
+    if (m == 0 or n < 3 or source.shape[0] != m or not (constant >= 0 and isfinite(constant))
             or not (gradation >= 1.0 and isfinite(gradation))):
         return None
     _check_pslg(vertices, segments)
     if ring_polygon is not None:
         _check_ring_polygon(edge_source, ring_polygon, classify)
+    if holes.shape[1] != 2 or seeds.shape[1] != 2 or seed_ids.shape[0] != seeds.shape[0]:
+        raise ValueError("holes and seeds must be (h, 2) and (r, 2), seed_ids (r,)")
+    if (coordinate_flags(&holes[0, 0] if holes.shape[0] else NULL, 2 * holes.shape[0],
+                         EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
+            or coordinate_flags(&seeds[0, 0] if seeds.shape[0] else NULL, 2 * seeds.shape[0],
+                                EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)):
+        return None
     box_of(&vertices[0, 0], n, box)
     res = _math_ulp(max(max(fabs(box[0]), fabs(box[1])), max(fabs(box[2]), fabs(box[3]))))
-    if not constant >= rules[RULE_MIN_SIZE_ULPS] * res:
+    if constant and not constant >= rules[RULE_MIN_SIZE_ULPS] * res:
         return None
     if not area:
         area = max(box[2] - box[0], 1e-300) * max(box[3] - box[1], 1e-300)
@@ -378,9 +432,10 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     memset(&S, 0, sizeof(SizeField))
     try:
         return _generate_on(&S, field, vertices, segments, source, edge_source, classify,
-                            ring_polygon, constant, area, rules, rounds, max_pieces, progress_limit,
-                            order, max_triangles, min_area, close_factor, swaps, greedy,
-                            smooth_rounds, slide, min_angle, scaffold, n)
+                            ring_polygon, holes, seeds, seed_ids, constant, area, rules,
+                            rounds, max_pieces, progress_limit, order, max_triangles,
+                            min_area, close_factor, swaps, greedy, smooth_rounds, slide,
+                            min_angle, scaffold, n)
     finally:
         size_field_free(&S)
 
@@ -388,7 +443,9 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
 cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertices,
                          const int32_t[:, ::1] segments, const int32_t[::1] source,
                          const int32_t[::1] edge_source, bint classify,
-                         object ring_polygon, double constant,
+                         object ring_polygon, const double[:, ::1] holes,
+                         const double[:, ::1] seeds, const int32_t[::1] seed_ids,
+                         double constant,
                          double area, const double[::1] rules, object rounds,
                          double max_pieces, double progress_limit, int order,
                          long long max_triangles, object min_area, double close_factor,
@@ -440,7 +497,8 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
                     scaffold=scaffold)
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
                             e_out if classify else None, edge_source, ring_polygon,
-                            max_triangles, smooth_rounds, slide, min_angle, n)
+                            holes, seeds, seed_ids, max_triangles, smooth_rounds, slide,
+                            min_angle, n)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

@@ -4,6 +4,8 @@ the stages make, and hands every other case to them.
 Each test meshes the same input twice, once as generate does and once with the common
 case switched off, and compares every array and every reported count."""
 
+import math
+
 import numpy as np
 import pytest
 import shapely
@@ -21,7 +23,7 @@ from shapely.geometry import MultiPolygon, Polygon, box
 import aftmesh
 import aftmesh._common as common
 from aftmesh import inputs
-from aftmesh.errors import InvalidSizeError
+from aftmesh.errors import InvalidDomainError, InvalidInputError, InvalidSizeError
 
 MESH_ARRAYS = ("points", "triangles", "neighbors", "segments", "regions")
 FIELD_ARRAYS = ("points", "user", "graded", "triangles", "neighbors")
@@ -68,6 +70,13 @@ def assert_same_mesh(a, b):
     assert set(a.info["timing"]) == set(b.info["timing"])
 
 
+def _region_areas(mesh, regions) -> np.ndarray:
+    p, t = mesh.points, mesh.triangles
+    a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
+    area = 0.5 * ((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
+    return np.array([area[mesh.regions == r].sum() for r in regions])
+
+
 def _compare(monkeypatch, domain, size, checked=None, **kw):
     taken = Taken(monkeypatch)
     mesh = aftmesh.generate(domain, size, **kw)
@@ -110,30 +119,105 @@ def test_common_case_makes_the_stages_mesh_on_the_shapely_cases(monkeypatch, che
     _compare(monkeypatch, case.domain, case.size, checked)
 
 
+@pytest.mark.parametrize("case", shapely_cases(), ids=repr)
+def test_common_case_takes_the_size_from_the_edges_as_the_stages_do(monkeypatch, checked, case):
+    # size=None (the default): the input edges' lengths, graded; taken wherever a
+    # number size is (touching parts are classified by probes either way)
+    with monkeypatch.context() as m:
+        by_edges = _compare(m, case.domain, None, checked).taken
+    with monkeypatch.context() as m:
+        by_number = _compare(m, case.domain, case.size).taken
+    assert by_edges == by_number
+
+
 @pytest.mark.parametrize("name", ["A", "face", "la", "double_hex"])
 def test_common_case_makes_the_stages_mesh_on_triangle_samples(monkeypatch, checked, name):
     case = triangle_sample(name)
     _compare(monkeypatch, case.domain, case.size, checked)
 
 
-def test_common_case_takes_rings_dicts_and_holes_but_not_hole_points(monkeypatch):
+def test_common_case_takes_rings_dicts_holes_and_hole_points(monkeypatch):
     ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1.0]])
     assert _compare(monkeypatch, ring, 0.2).taken == 1
     square = {"vertices": ring, "segments": [[0, 1], [1, 2], [2, 3], [3, 0]]}
     assert _compare(monkeypatch, square, 0.2).taken == 1
     holed = box(0, 0, 2, 2).difference(box(0.5, 0.5, 1, 1))
     assert _compare(monkeypatch, holed, 0.2).taken == 1
-    inner = [[0.8, 0.4], [1.2, 0.4], [1.2, 0.6], [0.8, 0.6]]
-    framed = {
-        "vertices": np.vstack([ring, inner]),
-        "segments": square["segments"] + [[4, 5], [5, 6], [6, 7], [7, 4]],
-        "holes": [[1.0, 0.5]],
-    }
-    taken = _compare(monkeypatch, framed, 0.2)
-    assert taken.taken == taken.declined == 0  # not even tried: Triangle's hole points
+    assert _compare(monkeypatch, FRAMED, 0.2).taken == 1  # Triangle's hole points
     parts = [box(0, 0, 1, 1), box(1, 0, 2, 1)]
     taken = _compare(monkeypatch, parts, 0.2)
     assert taken.taken == taken.declined == 0  # two regions: classified by probes
+
+
+# Triangle's way: a frame and a square inside it, with a hole point in the square
+INNER = [[0.8, 0.4], [1.2, 0.4], [1.2, 0.6], [0.8, 0.6]]
+FRAMED = {
+    "vertices": [[0, 0], [2, 0], [2, 1], [0, 1.0]] + INNER,
+    "segments": [[0, 1], [1, 2], [2, 3], [3, 0], [4, 5], [5, 6], [6, 7], [7, 4]],
+    "holes": [[1.0, 0.5]],
+}
+
+
+def test_common_case_gives_region_points_their_markers(monkeypatch, checked):
+    marked = {**FRAMED, "holes": [], "regions": [[0.1, 0.1, 7], [1.0, 0.5, -3]]}
+    assert _compare(monkeypatch, marked, 0.2, checked).taken == 1
+    mesh = aftmesh.generate(marked, 0.2)
+    assert set(np.unique(mesh.regions)) == {7, -3}
+    assert np.allclose(_region_areas(mesh, [7, -3]), [2.0 - 0.08, 0.08], rtol=1e-12)
+    both = {**FRAMED, "regions": [[0.1, 0.1, 5]]}  # the square a hole, the frame region 5
+    assert _compare(monkeypatch, both, 0.2, checked).taken == 1
+
+
+@pytest.mark.parametrize(
+    "where, message",
+    [
+        ({"holes": [[0.8, 0.5]]}, r"holes\[0\] = \(0\.8, 0\.5\) lies on a segment"),
+        ({"holes": [[1.2, 0.6]]}, r"holes\[0\] = \(1\.2, 0\.6\) lies on a segment"),
+        ({"holes": [[3.0, 0.5]]}, r"holes\[0\] = \(3, 0\.5\) is not inside the domain"),
+        ({"regions": [[1.0, 0.5, 1], [2.0, 0.0, 2]]}, r"regions\[1\] = \(2, 0\) lies on"),
+    ],
+)
+def test_common_case_leaves_misplaced_points_to_the_stages_errors(monkeypatch, where, message):
+    taken = Taken(monkeypatch)
+    with pytest.raises(InvalidDomainError, match=message):
+        aftmesh.generate({**FRAMED, **where}, 0.2)
+    assert taken.declined == 1 and taken.taken == 0
+
+
+def test_common_case_leaves_fractional_region_markers_to_the_stages(monkeypatch):
+    taken = Taken(monkeypatch)
+    with pytest.raises(InvalidInputError, match=r"regions\[0\] has marker 1\.5"):
+        aftmesh.generate({**FRAMED, "regions": [[0.1, 0.1, 1.5]]}, 0.2)
+    assert taken.declined == taken.taken == 0
+
+
+@st.composite
+def dicts_with_hole_points(draw):
+    """polygons_with_circular_holes as Triangle's dict: each disc a hole point at its
+    centre, or a region point with a marker, and maybe a marker for the square."""
+    poly = draw(polygons_with_circular_holes())
+    rings = [poly.exterior] + list(poly.interiors)
+    vertices, segments, holes, regions = [], [], [], []
+    for ring in rings:
+        xy = np.asarray(ring.coords)[:-1]
+        k = len(vertices)
+        vertices.extend(xy.tolist())
+        segments.extend([k + i, k + (i + 1) % len(xy)] for i in range(len(xy)))
+    for ring in poly.interiors:
+        centre = list(Polygon(ring).centroid.coords[0])
+        if draw(st.booleans()):
+            holes.append(centre)
+        else:
+            regions.append(centre + [draw(st.integers(-5, 5))])
+    if draw(st.booleans()):
+        regions.append([0.02, 0.02, draw(st.integers(-5, 5))])
+    return {"vertices": vertices, "segments": segments, "holes": holes, "regions": regions}
+
+
+@given(dicts_with_hole_points(), st.sampled_from([0.05, 0.2, None]))
+def test_common_case_makes_the_stages_mesh_with_hole_and_region_points(domain, size):
+    with pytest.MonkeyPatch.context() as monkeypatch:
+        assert _compare(monkeypatch, domain, size).taken == 1
 
 
 def test_common_case_declines_what_only_the_stages_report(monkeypatch):
@@ -202,14 +286,23 @@ def test_no_standard_error_draws_no_bar_and_raises_nothing(monkeypatch, checked)
     checked(aftmesh.generate(box(0, 0, 1, 1), 0.05, split_boundary=False))  # the stages
 
 
-def test_common_case_takes_only_plain_numbers(monkeypatch):
+def test_common_case_takes_only_plain_numbers_and_none(monkeypatch):
     taken = _compare(monkeypatch, box(0, 0, 1, 1), np.float64(0.25))
     assert taken.taken == 0
     taken = _compare(monkeypatch, box(0, 0, 1, 1), 1)
     assert taken.taken == 1
+    taken = _compare(monkeypatch, box(0, 0, 1, 1), lambda x, y: 0.2 + 0 * x)
+    assert taken.taken == 0
+    taken = _compare(monkeypatch, STRIP, None)
+    assert taken.taken == 1
+    for bad in (0, 0.0, -1.0, math.inf, math.nan):
+        taken = Taken(monkeypatch)
+        with pytest.raises(InvalidSizeError, match="finite and positive"):
+            aftmesh.generate(STRIP, bad)
+        assert taken.taken == taken.declined == 0  # the stages' message
 
 
-@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0]))
+@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0, None]))
 def test_common_case_makes_the_stages_mesh_on_random_polygons(poly, size):
     with pytest.MonkeyPatch.context() as monkeypatch:
         _compare(monkeypatch, poly, size)
@@ -222,7 +315,7 @@ def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size):
         _compare(monkeypatch, corner, size)
 
 
-@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4]))
+@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4, None]))
 def test_common_case_makes_the_stages_mesh_on_random_polygons_with_holes(poly, size):
     with pytest.MonkeyPatch.context() as monkeypatch:
         _compare(monkeypatch, poly, size)
@@ -236,13 +329,6 @@ def test_common_case_classifies_holes_touching_the_exterior_and_each_other(monke
     )
     assert touching.is_valid
     assert _compare(monkeypatch, touching, 0.2, checked).taken == 1
-
-
-def _region_areas(mesh) -> np.ndarray:
-    p, t = mesh.points, mesh.triangles
-    a, b, c = p[t[:, 0]], p[t[:, 1]], p[t[:, 2]]
-    area = 0.5 * ((b - a)[:, 0] * (c - a)[:, 1] - (b - a)[:, 1] * (c - a)[:, 0])
-    return np.bincount(mesh.regions, weights=area)
 
 
 # islands in lakes in islands, beside a square apart: four parts, each its own region
@@ -260,10 +346,11 @@ def test_common_case_gives_nested_parts_the_regions_the_probes_give(monkeypatch,
     taken = _compare(monkeypatch, LAKES, 0.4, checked)
     assert taken.taken == 1
     mesh = aftmesh.generate(LAKES, 0.4)
-    assert np.allclose(_region_areas(mesh), [g.area for g in LAKES.geoms], rtol=1e-12)
+    areas = _region_areas(mesh, range(len(LAKES.geoms)))
+    assert np.allclose(areas, [g.area for g in LAKES.geoms], rtol=1e-12)
 
 
-@given(nested_multipolygons(), st.sampled_from([0.05, 0.2]))
+@given(nested_multipolygons(), st.sampled_from([0.05, 0.2, None]))
 def test_common_case_makes_the_stages_mesh_on_nested_multipolygons(multi, size):
     with pytest.MonkeyPatch.context() as monkeypatch:
         taken = _compare(monkeypatch, multi, size)
@@ -304,5 +391,8 @@ def test_generate_common_refuses_a_ring_polygon_that_misses_a_source():
     numbers = (0.5, 1.5, 1.0, None, common._RULES, 100.0, 1e9, 0, -1, None, 0.5)
     switches = (True, False, 3, True, 0.0, False)
     wrong = np.zeros(1, dtype=np.int32)  # one ring, but edge 3 is of source 1
+    points = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, dtype=np.int32))  # holes, seeds
     with pytest.raises(ValueError, match=r"edge_source\[3\] = 1 names no ring"):
-        generate_common(ring, segments, source, edge_source, True, wrong, *numbers, *switches)
+        generate_common(
+            ring, segments, source, edge_source, True, wrong, *points, *numbers, *switches
+        )

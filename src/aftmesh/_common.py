@@ -1,12 +1,12 @@
 """generate's common case in one kernel call.
 
 Most calls mesh one polygon (with or without holes, or a dict's rings) at one number
-size with the compiled subtasks.  For those, the stages of :mod:`aftmesh._stages` from
-the size field to the refined mesh run as one compiled call
-(``cython_ext/pipeline.pxi``), which applies the stages' rules in the same order, so
-the mesh is the one they make.  Whatever that call does not reproduce (a retry for
-rounding, region classification by probes, a progress bar, an error message), it
-declines, and generate runs the stages instead.
+size, or at the size its edges give (size=None), with the compiled subtasks.  For
+those, the stages of :mod:`aftmesh._stages` from the size field to the refined mesh
+run as one compiled call (``cython_ext/pipeline.pxi``), which applies the stages'
+rules in the same order, so the mesh is the one they make.  Whatever that call does
+not reproduce (a retry for rounding, region classification by probes, a progress
+bar, an error message), it declines, and generate runs the stages instead.
 """
 
 from __future__ import annotations
@@ -57,31 +57,51 @@ _RULES = np.array(
 )
 assert len(_RULES) == COMMON_RULE_COUNT
 _RULES.setflags(write=False)
+# no hole or region points
+_NO_POINTS = np.zeros((0, 2), dtype=np.float64)
+_NO_IDS = np.zeros(0, dtype=np.int32)
+
+
+def _points(rows: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(rows, dtype=np.float64)
+
+
 # A double holds every integer below this exactly: a larger int size takes the stages
 # (whose float() of it the compiled call would not reproduce past it).
 _EXACT_INT = 2**53
 
 
 def _is_plain_number(size) -> bool:
+    """A float or an int that a double holds exactly, above 0 and finite: the stages
+    refuse the others, with their message (the compiled call reads 0 as size=None)."""
     if type(size) is float:
-        return True
-    return type(size) is int and -_EXACT_INT < size < _EXACT_INT
+        return 0.0 < size < math.inf
+    return type(size) is int and 0 < size < _EXACT_INT
 
 
 def applies(dom: Domain, size, opts: Options) -> bool:
-    """Whether the compiled call may take this generate call: a plain number size, the
-    compiled subtasks with split input edges, no progress bar asked for, and one
-    polygon (holes allowed, no constraint lines), polygons whose rings meet nowhere,
-    or a dict or .poly without holes or region points."""
+    """Whether the compiled call may take this generate call: a plain number size or
+    None (the input edges' lengths), the compiled subtasks with split input edges, no
+    progress bar asked for, and one polygon (holes allowed, no constraint lines),
+    polygons whose rings meet nowhere, or a dict or .poly (Triangle's hole and region
+    points allowed)."""
     return (
-        _is_plain_number(size)
+        (size is None or _is_plain_number(size))
         and opts.compiled
         and opts.split_boundary
         and (opts.progress is None or opts.progress is False)
-        and (dom.holes is None or len(dom.holes) == 0)
-        and (dom.region_points is None or len(dom.region_points) == 0)
+        and _plain_markers(dom.region_points)
         and (dom.polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom))
     )
+
+
+def _plain_markers(region_points: np.ndarray | None) -> bool:
+    """No region points, or region markers that pslg.build_cdt takes as they are
+    (whole numbers in the int32 range; it refuses the others, naming them)."""
+    if region_points is None or len(region_points) == 0:
+        return True
+    markers = region_points[:, 2]
+    return bool((markers == np.rint(markers)).all() and (np.abs(markers) <= 2**31 - 1).all())
 
 
 def _one_polygon_of_rings(dom: Domain) -> bool:
@@ -110,6 +130,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
     """The Mesh of generate by the compiled call, or None where it declines (then
     nothing has changed, and the stages run).  The caller checked `applies`."""
     refining = bool(opts.min_angle) and not opts.greedy and opts.swaps
+    seeds = dom.region_points if dom.region_points is not None and len(dom.region_points) else None
     cap, _ = opts.triangle_cap
     out = generate_common(
         np.ascontiguousarray(dom.vertices, dtype=np.float64),
@@ -118,7 +139,10 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         np.ascontiguousarray(dom.edge_source, dtype=np.int32),
         dom.polygons is not None and dom.n_rings > 1,  # holes or parts: pieces to classify
         dom.ring_polygon,
-        float(size),
+        _NO_POINTS if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
+        _NO_POINTS if seeds is None else _points(seeds[:, :2]),
+        _NO_IDS if seeds is None else seeds[:, 2].astype(np.int32),
+        0.0 if size is None else float(size),  # 0: the size from the input edges
         float(opts.gradation),
         float(dom.area or 0.0),
         round_keys,
@@ -140,7 +164,8 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         return None
     kernel, source, _n_boundary, n_merged, arrays, _expected, moves, done, times = out
     t_boundary, t_cdt, t_aft = times
-    field = SizeField(float(size)) if arrays is None else SizeField(float(size), *arrays)
+    constant = 0.0 if size is None else float(size)
+    field = SizeField(constant) if arrays is None else SizeField(constant, *arrays)
     refined = None
     if done is not None:
         refined = {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}
