@@ -2,7 +2,9 @@
 valgrind's callgrind: a measure that does not move with the machine's load.
 
 ``python -m benchmarks.instructions [CASE ...]`` meshes each case (the fixed-cost
-strip ``strip-100`` and the "small and real" outlines of ``benchmarks.overhead``, by
+strip ``strip-100``, its other forms ``strip-100/none`` (no size), ``strip-100/x3``
+(three copies as one multipolygon) and ``strip-100/dict-hole`` (a Triangle dict with
+a hole point), and the "small and real" outlines of ``benchmarks.overhead``, by
 name, or any case of the main table, ``square-<h>`` for any h among them, given as that
 table gives it) in a child process under callgrind, twice: once with ``--calls`` counted calls
 after one warm-up call, once with the warm-up call alone.  The difference over the
@@ -96,21 +98,25 @@ print(len(mesh.triangles))
 
 
 def case_names() -> list[str]:
-    """The named outlines (generate_args also takes the cases of benchmarks.cases)."""
-    from .overhead import overhead_outline, real_outlines
+    """The named outlines and the strip's other forms (generate_args also takes the
+    cases of benchmarks.cases)."""
+    from .overhead import overhead_forms, overhead_outline, real_outlines
 
-    return [c.name for c in [overhead_outline()] + real_outlines()]
+    return [c.name for c in [overhead_outline()] + real_outlines()] + list(overhead_forms())
 
 
 def generate_args(name: str) -> tuple[tuple, dict]:
     """generate's arguments for a case: a named outline (polygon and size), or any case
     of ``benchmarks.cases`` (``square-<h>`` for any h, ``naca0012``, ...) given as the
     main table's ``aft`` gives it.  KeyError or ValueError for an unknown name."""
-    from .overhead import overhead_outline, real_outlines
+    from .overhead import overhead_forms, overhead_outline, real_outlines
 
     outline = next((c for c in [overhead_outline()] + real_outlines() if c.name == name), None)
     if outline is not None:
         return (outline.polygon, outline.size), {}
+    forms = overhead_forms()
+    if name in forms:
+        return forms[name]
     from .cases import build_case
 
     case = build_case(name)

@@ -208,6 +208,36 @@ def overhead_outline() -> Outline:
     return Outline("strip-100", strip(OVERHEAD_VERTICES, seed=1, width=STRIP_WIDTH), 1.0)
 
 
+def overhead_forms() -> dict[str, tuple[tuple, dict]]:
+    """generate's arguments for the fixed-cost strip in the other forms users pass:
+    without a size (the edges' sizes), as a multipolygon of three copies side by side,
+    and as a Triangle dict with a square hole and its hole point."""
+    from shapely import affinity
+    from shapely.geometry import MultiPolygon
+
+    case = overhead_outline()
+    poly = case.polygon
+    x0, y0, x1, y1 = poly.bounds
+    step = 2.0 * (y1 - y0)
+    copies = MultiPolygon([affinity.translate(poly, 0.0, k * step) for k in range(3)])
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    half = 0.25 * STRIP_WIDTH
+    square = [[cx - half, cy - half], [cx + half, cy - half], [cx + half, cy + half],
+              [cx - half, cy + half]]  # fmt: skip
+    n = len(case.ring)
+    holed = {
+        "vertices": np.vstack([case.ring, square]),
+        "segments": [[i, (i + 1) % n] for i in range(n)]
+        + [[n + i, n + (i + 1) % 4] for i in range(4)],
+        "holes": [[cx, cy]],
+    }
+    return {
+        f"{case.name}/none": ((poly,), {}),
+        f"{case.name}/x3": ((copies, case.size), {}),
+        f"{case.name}/dict-hole": ((holed, case.size), {}),
+    }
+
+
 def real_outlines(folder: Path = REALWORLD) -> list[Outline]:
     """The "small and real" group: files under data/realworld if any, else made."""
     files = sorted(folder.glob("*.json")) if folder.is_dir() else []

@@ -194,6 +194,22 @@ cdef void _check_ring_polygon(const int32_t[::1] edge_source,
                              f"ring_polygon (length {k})")
 
 
+cdef bint _seed_points_usable(object holes, object seeds, object seed_ids) except -1:
+    """generate_common's hole and region points are (h, 2) and (r, 2) with r ids (a
+    ValueError if not) and every coordinate is in the exact predicates' range (else
+    the stages check them, with their messages)."""
+    cdef const double[:, ::1] hv = np.zeros((0, 2)) if holes is None else holes
+    cdef const double[:, ::1] sv = np.zeros((0, 2)) if seeds is None else seeds
+    cdef const int32_t[::1] iv = np.zeros(0, dtype=np.int32) if seed_ids is None else seed_ids
+    if hv.shape[1] != 2 or sv.shape[1] != 2 or iv.shape[0] != sv.shape[0]:
+        raise ValueError("holes and seeds must be (h, 2) and (r, 2), seed_ids (r,)")
+    return not (
+        coordinate_flags(&hv[0, 0] if hv.shape[0] else NULL, 2 * hv.shape[0],
+                         EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
+        or coordinate_flags(&sv[0, 0] if sv.shape[0] else NULL, 2 * sv.shape[0],
+                            EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE))
+
+
 cdef double _clock() noexcept nogil:
     """time.perf_counter() (CLOCK_MONOTONIC on Linux, in seconds), without the GIL."""
     cdef timespec ts
@@ -300,8 +316,8 @@ cdef int _carve_and_seed(Tri* T, const Pieces* P) noexcept nogil:
 cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               const int32_t[:, ::1] seg, object piece_edge,
                               const int32_t[::1] edge_source, object ring_polygon,
-                              const double[:, ::1] holes, const double[:, ::1] seeds,
-                              const int32_t[::1] seed_ids, long long max_triangles,
+                              object holes, object seeds, object seed_ids,
+                              long long max_triangles,
                               int smooth_rounds, bint slide, double min_angle,
                               int n_corners):
     """_mesh_pieces on tri (its size field and options set), with the def layer's
@@ -312,6 +328,9 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
     cdef int outcome, nv = tri.T.nv
     cdef const int32_t[::1] pe
     cdef const int32_t[::1] rp
+    cdef const double[:, ::1] hv
+    cdef const double[:, ::1] sv
+    cdef const int32_t[::1] iv
     memset(&P, 0, sizeof(Pieces))
     P.m = seg.shape[0]
     P.rounds = &rounds[0] if nv else NULL
@@ -323,11 +342,16 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
         if ring_polygon is not None:
             rp = ring_polygon
             P.ring_polygon = &rp[0]
-    P.n_holes = holes.shape[0]
-    P.holes = &holes[0, 0] if P.n_holes else NULL
-    P.n_seeds = seeds.shape[0]
-    P.seeds = &seeds[0, 0] if P.n_seeds else NULL
-    P.seed_ids = &seed_ids[0] if P.n_seeds else NULL
+    if holes is not None:
+        hv = holes
+        P.n_holes = hv.shape[0]
+        P.holes = &hv[0, 0] if P.n_holes else NULL
+    if seeds is not None:
+        sv = seeds
+        iv = seed_ids
+        P.n_seeds = sv.shape[0]
+        P.seeds = &sv[0, 0] if P.n_seeds else NULL
+        P.seed_ids = &iv[0] if P.n_seeds else NULL
     P.max_triangles = max_triangles
     P.first_movable = nv
     P.n_corner = n_corners if slide else -1
@@ -364,8 +388,8 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
 
 def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
                     const int32_t[::1] source, const int32_t[::1] edge_source,
-                    bint classify, object ring_polygon, const double[:, ::1] holes,
-                    const double[:, ::1] seeds, const int32_t[::1] seed_ids,
+                    bint classify, object ring_polygon, object holes, object seeds,
+                    object seed_ids,
                     double constant, double gradation,
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
@@ -378,8 +402,9 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     the exterior ring source 0; or, with ring_polygon (an int32 array: the polygon of
     each source ring), a valid multipolygon whose rings meet nowhere, its pieces
     classified by how they nest (domain.pxi's nested_regions).  holes, seeds and
-    seed_ids: Triangle's hole points and region points with their ids ((0, 2), (0, 2)
-    and (0,) for none), as pslg.build_cdt applies them.  rounds: _order.round_keys,
+    seed_ids: Triangle's hole points and region points with their ids (float64
+    (h, 2), (r, 2) and int32 (r,) arrays, or None for none), as pslg.build_cdt
+    applies them.  rounds: _order.round_keys,
     called for the BRIO round keys of the background's and the boundary's points;
     max_pieces: the most boundary pieces allowed; progress_limit: the triangle hint
     above which a progress bar may be wanted; slide: smoothing slides the boundary's
@@ -401,12 +426,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     _check_pslg(vertices, segments)
     if ring_polygon is not None:
         _check_ring_polygon(edge_source, ring_polygon, classify)
-    if holes.shape[1] != 2 or seeds.shape[1] != 2 or seed_ids.shape[0] != seeds.shape[0]:
-        raise ValueError("holes and seeds must be (h, 2) and (r, 2), seed_ids (r,)")
-    if (coordinate_flags(&holes[0, 0] if holes.shape[0] else NULL, 2 * holes.shape[0],
-                         EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)
-            or coordinate_flags(&seeds[0, 0] if seeds.shape[0] else NULL, 2 * seeds.shape[0],
-                                EXACT_MIN_COORDINATE, EXACT_MAX_COORDINATE)):
+    seeded = holes is not None or seeds is not None
+    if seeded and not _seed_points_usable(holes, seeds, seed_ids):
         return None
     box_of(&vertices[0, 0], n, box)
     res = _math_ulp(max(max(fabs(box[0]), fabs(box[1])), max(fabs(box[2]), fabs(box[3]))))
@@ -443,8 +464,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
 cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertices,
                          const int32_t[:, ::1] segments, const int32_t[::1] source,
                          const int32_t[::1] edge_source, bint classify,
-                         object ring_polygon, const double[:, ::1] holes,
-                         const double[:, ::1] seeds, const int32_t[::1] seed_ids,
+                         object ring_polygon, object holes, object seeds,
+                         object seed_ids,
                          double constant,
                          double area, const double[::1] rules, object rounds,
                          double max_pieces, double progress_limit, int order,

@@ -391,8 +391,24 @@ def test_generate_common_refuses_a_ring_polygon_that_misses_a_source():
     numbers = (0.5, 1.5, 1.0, None, common._RULES, 100.0, 1e9, 0, -1, None, 0.5)
     switches = (True, False, 3, True, 0.0, False)
     wrong = np.zeros(1, dtype=np.int32)  # one ring, but edge 3 is of source 1
-    points = (np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0, dtype=np.int32))  # holes, seeds
+    points = (None, None, None)  # no hole or region points
     with pytest.raises(ValueError, match=r"edge_source\[3\] = 1 names no ring"):
         generate_common(
             ring, segments, source, edge_source, True, wrong, *points, *numbers, *switches
         )
+
+
+def test_generate_common_refuses_region_points_without_one_id_each():
+    from aftmesh._kernel import generate_common
+
+    ring = np.array([[0, 0], [1, 0], [1, 1], [0, 1.0]])
+    segments = np.array([[0, 1], [1, 2], [2, 3], [3, 0]], dtype=np.int32)
+    source = np.arange(4, dtype=np.int32)
+    numbers = (0.5, 1.5, 1.0, None, common._RULES, 100.0, 1e9, 0, -1, None, 0.5)
+    switches = (True, False, 3, True, 0.0, False)
+    seeds = np.array([[0.5, 0.5], [0.2, 0.2]])
+    with pytest.raises(ValueError, match="seed_ids"):
+        generate_common(
+            ring, segments, source, source * 0, False, None, None, seeds,
+            np.zeros(1, dtype=np.int32), *numbers, *switches,
+        )  # fmt: skip

@@ -57,9 +57,6 @@ _RULES = np.array(
 )
 assert len(_RULES) == COMMON_RULE_COUNT
 _RULES.setflags(write=False)
-# no hole or region points
-_NO_POINTS = np.zeros((0, 2), dtype=np.float64)
-_NO_IDS = np.zeros(0, dtype=np.int32)
 
 
 def _points(rows: np.ndarray) -> np.ndarray:
@@ -139,9 +136,9 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         np.ascontiguousarray(dom.edge_source, dtype=np.int32),
         dom.polygons is not None and dom.n_rings > 1,  # holes or parts: pieces to classify
         dom.ring_polygon,
-        _NO_POINTS if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
-        _NO_POINTS if seeds is None else _points(seeds[:, :2]),
-        _NO_IDS if seeds is None else seeds[:, 2].astype(np.int32),
+        None if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
+        None if seeds is None else _points(seeds[:, :2]),
+        None if seeds is None else seeds[:, 2].astype(np.int32),
         0.0 if size is None else float(size),  # 0: the size from the input edges
         float(opts.gradation),
         float(dom.area or 0.0),
