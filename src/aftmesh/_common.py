@@ -24,6 +24,7 @@ from .boundary import MAX_SAMPLES
 from .domain_record import Domain
 from .mesh import Mesh
 from .options import MAX_TRIANGLES, ORDERS, Options
+from .pslg import fractional_markers, markers_out_of_range
 from .sizing import (
     BOUNDARY_REACH,
     BOX_PAD,
@@ -98,7 +99,7 @@ def _plain_markers(region_points: np.ndarray | None) -> bool:
     if region_points is None or len(region_points) == 0:
         return True
     markers = region_points[:, 2]
-    return bool((markers == np.rint(markers)).all() and (np.abs(markers) <= 2**31 - 1).all())
+    return not (fractional_markers(markers).any() or markers_out_of_range(markers).any())
 
 
 def _one_polygon_of_rings(dom: Domain) -> bool:

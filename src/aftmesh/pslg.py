@@ -127,6 +127,21 @@ def as_segments(value: npt.ArrayLike | None, n_vertices: int, vertices: np.ndarr
     return seg.astype(np.int32)
 
 
+# Mesh.regions holds int32 markers; Triangle's regional attributes may be any number,
+# so build_cdt refuses a fractional or larger one rather than silently truncate it
+MAX_REGION_MARKER = 2**31 - 1
+
+
+def fractional_markers(markers: np.ndarray) -> np.ndarray:
+    """Which region markers are not whole numbers (NaN included)."""
+    return markers != np.rint(markers)
+
+
+def markers_out_of_range(markers: np.ndarray) -> np.ndarray:
+    """Which region markers an int32 does not hold."""
+    return np.abs(markers) > MAX_REGION_MARKER
+
+
 def build_cdt(
     vertices: npt.ArrayLike,
     segments: npt.ArrayLike | None = None,
@@ -157,15 +172,13 @@ def build_cdt(
         if not np.isfinite(reg).all():
             i = int(np.flatnonzero(~np.isfinite(reg).all(axis=1))[0])
             raise InvalidInputError(f"regions[{i}] = {reg[i].tolist()} is not finite")
-        # Mesh.regions holds integer markers; Triangle's regional attributes may be
-        # any number, so refuse rather than silently truncate one
-        frac = reg[:, 2] != np.rint(reg[:, 2])
+        frac = fractional_markers(reg[:, 2])
         if frac.any():
             i = int(np.flatnonzero(frac)[0])
             raise InvalidInputError(
                 f"regions[{i}] has marker {float(reg[i, 2])!r}: region markers must be integers"
             )
-        big = np.abs(reg[:, 2]) > 2**31 - 1
+        big = markers_out_of_range(reg[:, 2])
         if big.any():
             i = int(np.flatnonzero(big)[0])
             raise InvalidInputError(
