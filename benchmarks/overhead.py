@@ -211,7 +211,8 @@ def overhead_outline() -> Outline:
 def overhead_forms() -> dict[str, tuple[tuple, dict]]:
     """generate's arguments for the fixed-cost strip in the other forms users pass:
     without a size (the edges' sizes), as a multipolygon of three copies side by side,
-    and as a Triangle dict with a square hole and its hole point."""
+    as a Triangle dict with a square hole and its hole point, and with its input edges
+    kept whole (split_boundary=False, as the main table's aftmesh column meshes)."""
     from shapely import affinity
     from shapely.geometry import MultiPolygon
 
@@ -235,6 +236,7 @@ def overhead_forms() -> dict[str, tuple[tuple, dict]]:
         f"{case.name}/none": ((poly,), {}),
         f"{case.name}/x3": ((copies, case.size), {}),
         f"{case.name}/dict-hole": ((holed, case.size), {}),
+        f"{case.name}/whole": ((poly, case.size), {"split_boundary": False}),
     }
 
 

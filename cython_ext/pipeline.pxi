@@ -1,6 +1,8 @@
 # generate's common case in one call: one polygon (holes allowed), polygons whose
 # rings meet nowhere, or a dict or .poly domain (with Triangle's hole and region
-# points or without), meshed at a constant size with the compiled subtasks.
+# points or without), meshed at a constant size with the compiled subtasks, its input
+# edges split by the size or kept whole (split_boundary=False: then they are the
+# boundary's pieces, and the minimum-angle pass splits none of them).
 #
 # It is the data flow of _stages.py (size field, count, discretization, boundary CDT,
 # front, smoothing, minimum-angle pass) with the glue between the kernel calls in C
@@ -121,6 +123,28 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     if not finite:
         return False
     return pts_arr, u_arr, g_arr, tv, nb, spread - 1.0, rules[RULE_BOUNDARY_REACH]
+
+
+cdef object _on_segments(const double[:, ::1] v, double* short):
+    """The vertices on a segment, those whose short[i] is finite (v itself when all
+    are), with their short values moved to the front of short in the same order: the
+    size field's points, as _stages.size_field drops the lone points (a dict's free
+    vertices, meshed as they are, ask for no size)."""
+    cdef Py_ssize_t n = v.shape[0], i, k = 0
+    for i in range(n):
+        k += isfinite(short[i])
+    if k == n:
+        return v
+    out_arr = np.empty((k, 2), dtype=np.float64)
+    cdef double* out = _f64v(out_arr)
+    k = 0
+    for i in range(n):
+        if isfinite(short[i]):
+            out[2 * k] = v[i, 0]
+            out[2 * k + 1] = v[i, 1]
+            short[k] = short[i]
+            k += 1
+    return out_arr
 
 
 cdef double _smallest_size(const double[::1] u, const double[::1] g):
@@ -319,9 +343,9 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               object holes, object seeds, object seed_ids,
                               long long max_triangles,
                               int smooth_rounds, bint slide, double min_angle,
-                              int n_corners):
-    """_mesh_pieces on tri (its size field and options set), with the def layer's
-    error handling: None where the stages must run, else (merged vertices, smoothing
+                              bint split, int n_corners):
+    """_mesh_pieces on tri (its size field and options set; split: the minimum-angle
+    pass may split input segments), with the def layer's error handling: None where the stages must run, else (merged vertices, smoothing
     moves, the refine pass's counts or None, t_cdt, t_aft)."""
     cdef Pieces P
     cdef Refine R
@@ -359,7 +383,7 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
     P.refining = min_angle != 0
     memset(&R, 0, sizeof(Refine))
     if P.refining:
-        _refine_setup(&R, min_angle, n_corners, True)
+        _refine_setup(&R, min_angle, n_corners, split)
     merged_arr = np.empty(nv, dtype=np.int32)
     cdef int32_t* merged = _i32v(merged_arr)
     tri.A.progress = NULL
@@ -394,7 +418,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double area, object rounds, const double[::1] rules, double max_pieces,
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
-                    int smooth_rounds, bint slide, double min_angle, bint scaffold):
+                    int smooth_rounds, bint slide, double min_angle, bint scaffold,
+                    bint split=True):
     """The stages of generate from the size field to the refined mesh, for a number
     size, `constant` (0: size=None, the input edges' lengths alone; see the top of
     pipeline.pxi).  classify: the domain is one valid polygon
@@ -408,7 +433,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     called for the BRIO round keys of the background's and the boundary's points;
     max_pieces: the most boundary pieces allowed; progress_limit: the triangle hint
     above which a progress bar may be wanted; slide: smoothing slides the boundary's
-    split points along their input edges; min_angle 0: no pass.
+    split points along their input edges; min_angle 0: no pass; split: the input
+    edges are cut by the size (split_boundary), else kept whole.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
@@ -417,6 +443,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     cdef double box[4]
     cdef double res
     cdef double* short
+    cdef double* longest = NULL
+    cdef int32_t* ends = NULL
     cdef SizeField S
     if rules.shape[0] != N_RULES:
         raise ValueError(f"rules must hold {N_RULES} values")
@@ -436,16 +464,23 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     if not area:
         area = max(box[2] - box[0], 1e-300) * max(box[3] - box[1], 1e-300)
     short = <double*> malloc(n * sizeof(double))
-    if short == NULL:
-        raise MemoryError()
+    if not split:
+        longest = <double*> malloc(n * sizeof(double))
+        ends = <int32_t*> malloc(3 * n * sizeof(int32_t))
     try:
-        shortest_edges_into(&vertices[0, 0], n, &segments[0, 0], m, short)
-        for i in range(n):
-            if not isfinite(short[i]):     # a lone point: the stages drop it first
-                return None
-        field = _common_field(vertices, box, res, constant, gradation, short, rules, rounds)
+        if short == NULL or (not split and (longest == NULL or ends == NULL)):
+            raise MemoryError()
+        if split:
+            shortest_edges_into(&vertices[0, 0], n, &segments[0, 0], m, short)
+        else:   # the sizes _stages.size_field asks for with the edges kept whole
+            kept_edge_sizes_into(&vertices[0, 0], n, &segments[0, 0], m, short, longest,
+                                 ends)
+        field = _common_field(_on_segments(vertices, short), box, res, constant, gradation,
+                              short, rules, rounds)
     finally:
         free(short)
+        free(longest)
+        free(ends)
     if field is False:
         return None
     # one copy of the field serves the count, the discretization and the front, each
@@ -456,7 +491,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                             ring_polygon, holes, seeds, seed_ids, constant, area, rules,
                             rounds, max_pieces, progress_limit, order, max_triangles,
                             min_area, close_factor, swaps, greedy, smooth_rounds, slide,
-                            min_angle, scaffold, n)
+                            min_angle, scaffold, split, n)
     finally:
         size_field_free(&S)
 
@@ -471,7 +506,7 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
                          double max_pieces, double progress_limit, int order,
                          long long max_triangles, object min_area, double close_factor,
                          bint swaps, bint greedy, int smooth_rounds, bint slide,
-                         double min_angle, bint scaffold, Py_ssize_t n):
+                         double min_angle, bint scaffold, bint split, Py_ssize_t n):
     """generate_common from its size field on (field: _common_field's arrays, or None
     for the constant), S the kernel's copy of it, which the triangulation takes."""
     cdef double expected, h_min, covered, share, hint_f, total
@@ -493,12 +528,15 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
     if not expected <= rules[RULE_MAX_TRIANGLES]:
         return None
     t_boundary = perf_counter()
-    S.hint = 0
-    out = _discretize_on(S, vertices, segments, source, <int> rules[RULE_MAX_SAMPLES],
-                         max_pieces)
-    if out[1] is None:
-        return None
-    v_out, s_out, e_out = out
+    if split:
+        S.hint = 0
+        out = _discretize_on(S, vertices, segments, source, <int> rules[RULE_MAX_SAMPLES],
+                             max_pieces)
+        if out[1] is None:
+            return None
+        v_out, s_out, e_out = out
+    else:   # the input edges are the boundary's pieces (_stages.boundary_cdt)
+        v_out, s_out, e_out = np.asarray(vertices), np.asarray(segments), np.asarray(source)
     nv = len(v_out)
     hint_f = expected + 4 * nv
     hint = <long long> (hint_f if hint_f < rules[RULE_MAX_TRIANGLE_HINT]
@@ -519,7 +557,7 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
                             e_out if classify else None, edge_source, ring_polygon,
                             holes, seeds, seed_ids, max_triangles, smooth_rounds, slide,
-                            min_angle, n)
+                            min_angle, split, n)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

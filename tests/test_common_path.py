@@ -104,6 +104,9 @@ OPTIONS = [
     {"max_triangles": 200},
     {"progress": False},
     {"tolerance": 1e-9},
+    {"split_boundary": False},
+    {"split_boundary": False, "min_angle": 33.0},
+    {"split_boundary": False, "slide_boundary": False, "smooth": 2},
 ]
 
 
@@ -120,6 +123,17 @@ def test_common_case_makes_the_stages_mesh_on_the_shapely_cases(monkeypatch, che
 
 
 @pytest.mark.parametrize("case", shapely_cases(), ids=repr)
+def test_common_case_keeps_input_edges_whole_as_the_stages_do(monkeypatch, checked, case):
+    # split_boundary=False: no discretization, the kept-whole sizes at the vertices,
+    # no segment split by the minimum-angle pass; taken wherever split edges are
+    with monkeypatch.context() as m:
+        whole = _compare(m, case.domain, case.size, checked, split_boundary=False).taken
+    with monkeypatch.context() as m:
+        split = _compare(m, case.domain, case.size).taken
+    assert whole == split
+
+
+@pytest.mark.parametrize("case", shapely_cases(), ids=repr)
 def test_common_case_takes_the_size_from_the_edges_as_the_stages_do(monkeypatch, checked, case):
     # size=None (the default): the input edges' lengths, graded; taken wherever a
     # number size is (touching parts are classified by probes either way)
@@ -130,10 +144,11 @@ def test_common_case_takes_the_size_from_the_edges_as_the_stages_do(monkeypatch,
     assert by_edges == by_number
 
 
+@pytest.mark.parametrize("split", [True, False], ids=["split", "whole"])
 @pytest.mark.parametrize("name", ["A", "face", "la", "double_hex"])
-def test_common_case_makes_the_stages_mesh_on_triangle_samples(monkeypatch, checked, name):
+def test_common_case_makes_the_stages_mesh_on_triangle_samples(monkeypatch, checked, name, split):
     case = triangle_sample(name)
-    _compare(monkeypatch, case.domain, case.size, checked)
+    _compare(monkeypatch, case.domain, case.size, checked, split_boundary=split)
 
 
 def test_common_case_takes_rings_dicts_holes_and_hole_points(monkeypatch):
@@ -147,6 +162,23 @@ def test_common_case_takes_rings_dicts_holes_and_hole_points(monkeypatch):
     parts = [box(0, 0, 1, 1), box(1, 0, 2, 1)]
     taken = _compare(monkeypatch, parts, 0.2)
     assert taken.taken == taken.declined == 0  # two regions: classified by probes
+
+
+@pytest.mark.parametrize("split", [True, False], ids=["split", "whole"])
+def test_common_case_meshes_free_vertices_as_the_stages_do(monkeypatch, checked, split):
+    # a dict's vertices on no segment (Triangle's free points) are meshed where they
+    # are and ask for no size: the field is built on the others, in their order
+    ring = [[0, 0], [2, 0], [2, 1], [0, 1.0]]
+    free = {
+        "vertices": [[0.7, 0.5]] + ring + [[1.31, 0.42], [1.5, 0.75]],
+        "segments": [[1, 2], [2, 3], [3, 4], [4, 1]],
+    }
+    for size in (0.2, None, 0.05):
+        taken = _compare(monkeypatch, free, size, checked, split_boundary=split)
+        assert taken.taken == 1
+    mesh = aftmesh.generate(free, 0.2, split_boundary=split)
+    for p in ([0.7, 0.5], [1.31, 0.42], [1.5, 0.75]):
+        assert (mesh.points == p).all(axis=1).sum() == 1
 
 
 # Triangle's way: a frame and a square inside it, with a hole point in the square
@@ -214,10 +246,10 @@ def dicts_with_hole_points(draw):
     return {"vertices": vertices, "segments": segments, "holes": holes, "regions": regions}
 
 
-@given(dicts_with_hole_points(), st.sampled_from([0.05, 0.2, None]))
-def test_common_case_makes_the_stages_mesh_with_hole_and_region_points(domain, size):
+@given(dicts_with_hole_points(), st.sampled_from([0.05, 0.2, None]), st.booleans())
+def test_common_case_makes_the_stages_mesh_with_hole_and_region_points(domain, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
-        assert _compare(monkeypatch, domain, size).taken == 1
+        assert _compare(monkeypatch, domain, size, split_boundary=split).taken == 1
 
 
 def test_common_case_declines_what_only_the_stages_report(monkeypatch):
@@ -283,7 +315,7 @@ def test_no_standard_error_draws_no_bar_and_raises_nothing(monkeypatch, checked)
     taken = Taken(monkeypatch)
     checked(aftmesh.generate(box(0, 0, 1, 1), 0.05))
     assert taken.taken == 1  # no bar can show: the compiled call is taken
-    checked(aftmesh.generate(box(0, 0, 1, 1), 0.05, split_boundary=False))  # the stages
+    checked(aftmesh.generate(box(0, 0, 1, 1), lambda x, y: 0.05 + 0 * x))  # the stages
 
 
 def test_common_case_takes_only_plain_numbers_and_none(monkeypatch):
@@ -302,23 +334,23 @@ def test_common_case_takes_only_plain_numbers_and_none(monkeypatch):
         assert taken.taken == taken.declined == 0  # the stages' message
 
 
-@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0, None]))
-def test_common_case_makes_the_stages_mesh_on_random_polygons(poly, size):
+@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0, None]), st.booleans())
+def test_common_case_makes_the_stages_mesh_on_random_polygons(poly, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
-        _compare(monkeypatch, poly, size)
+        _compare(monkeypatch, poly, size, split_boundary=split)
 
 
-@given(st.floats(1e-9, 1e-2), st.floats(0.01, 0.5))
-def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size):
+@given(st.floats(1e-9, 1e-2), st.floats(0.01, 0.5), st.booleans())
+def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size, split):
     corner = shapely.Polygon([(0, 0), (1, 0), (1, 1 - chamfer), (1 - chamfer, 1), (0, 1)])
     with pytest.MonkeyPatch.context() as monkeypatch:
-        _compare(monkeypatch, corner, size)
+        _compare(monkeypatch, corner, size, split_boundary=split)
 
 
-@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4, None]))
-def test_common_case_makes_the_stages_mesh_on_random_polygons_with_holes(poly, size):
+@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4, None]), st.booleans())
+def test_common_case_makes_the_stages_mesh_on_random_polygons_with_holes(poly, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
-        _compare(monkeypatch, poly, size)
+        _compare(monkeypatch, poly, size, split_boundary=split)
 
 
 def test_common_case_classifies_holes_touching_the_exterior_and_each_other(monkeypatch, checked):
@@ -350,10 +382,10 @@ def test_common_case_gives_nested_parts_the_regions_the_probes_give(monkeypatch,
     assert np.allclose(areas, [g.area for g in LAKES.geoms], rtol=1e-12)
 
 
-@given(nested_multipolygons(), st.sampled_from([0.05, 0.2, None]))
-def test_common_case_makes_the_stages_mesh_on_nested_multipolygons(multi, size):
+@given(nested_multipolygons(), st.sampled_from([0.05, 0.2, None]), st.booleans())
+def test_common_case_makes_the_stages_mesh_on_nested_multipolygons(multi, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
-        taken = _compare(monkeypatch, multi, size)
+        taken = _compare(monkeypatch, multi, size, split_boundary=split)
     assert taken.taken + taken.declined == 1
     if inputs.proved_polygon(multi) is not None:
         assert taken.taken == 1

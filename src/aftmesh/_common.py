@@ -79,14 +79,13 @@ def _is_plain_number(size) -> bool:
 
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size or
-    None (the input edges' lengths), the compiled subtasks with split input edges, no
-    progress bar asked for, and one polygon (holes allowed, no constraint lines),
+    None (the input edges' lengths), the compiled subtasks (input edges split or kept
+    whole), no progress bar asked for, and one polygon (holes allowed, no constraint lines),
     polygons whose rings meet nowhere, or a dict or .poly (Triangle's hole and region
     points allowed)."""
     return (
         (size is None or _is_plain_number(size))
         and opts.compiled
-        and opts.split_boundary
         and (opts.progress is None or opts.progress is False)
         and _plain_markers(dom.region_points)
         and (dom.polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom))
@@ -157,6 +156,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         opts.slides,
         float(opts.min_angle) if refining else 0.0,
         opts.scaffold,
+        opts.split_boundary,
     )
     if out is None:
         return None
