@@ -4,9 +4,10 @@ valgrind's callgrind: a measure that does not move with the machine's load.
 ``python -m benchmarks.instructions [CASE ...]`` meshes each case (the fixed-cost
 strip ``strip-100``, its other forms ``strip-100/none`` (no size), ``strip-100/x3``
 (three copies as one multipolygon), ``strip-100/dict-hole`` (a Triangle dict with
-a hole point) and ``strip-100/whole`` (its input edges kept whole), and the "small and real" outlines of ``benchmarks.overhead``, by
-name, or any case of the main table, ``square-<h>`` for any h among them, given as that
-table gives it) in a child process under callgrind, twice: once with ``--calls`` counted calls
+a hole point) and ``strip-100/whole`` (its input edges kept whole), and the "small
+and real" outlines of ``benchmarks.overhead``, by name, or any case of the main
+table, ``square-<h>`` for any h among them, given as that table gives it) in a child
+process under callgrind, twice: once with ``--calls`` counted calls
 after one warm-up call, once with the warm-up call alone.  The difference over the
 number of calls is one call's cost, imports and warm-up left out; each stage is the
 same difference of the inclusive count of the kernel function that runs it.  The

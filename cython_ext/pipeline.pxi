@@ -345,8 +345,9 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               int smooth_rounds, bint slide, double min_angle,
                               bint split, int n_corners):
     """_mesh_pieces on tri (its size field and options set; split: the minimum-angle
-    pass may split input segments), with the def layer's error handling: None where the stages must run, else (merged vertices, smoothing
-    moves, the refine pass's counts or None, t_cdt, t_aft)."""
+    pass may split input segments), with the def layer's error handling: None where
+    the stages must run, else (merged vertices, smoothing moves, the refine pass's
+    counts or None, t_cdt, t_aft)."""
     cdef Pieces P
     cdef Refine R
     cdef int outcome, nv = tri.T.nv
