@@ -13,7 +13,9 @@ different counts from the same boundary and size), and the per-stage breakdown
 over the size (``edge/h``) and the count a uniform mesh of the size would have
 (``uniform``): where the input's vertices are closer than the size, every mesher
 keeps them, and aftmesh grades its triangles from their spacing up to the size
-(Triangle refines only as far as its angle bound needs).
+(Triangle refines only as far as its angle bound needs).  ``--real --bare`` meshes
+without smoothing and the minimum-angle pass (``BARE_OPTIONS``): Basic_aft alone,
+what the front itself costs against Triangle.
 
 Times are process CPU time unless marked wall.  aftmesh and Triangle are timed call
 by call in turns, so a burst of load on a shared machine weighs on both; still run it
@@ -326,15 +328,17 @@ def _aftmesh():
     return aftmesh
 
 
-def _runners(case: Outline):
+def _runners(case: Outline, options: dict | None = None):
+    """aftmesh (with generate's `options`) and Triangle on the outline, as calls."""
     import triangle
 
     aftmesh = _aftmesh()
     poly = case.polygon
     tri_dict = case.triangle_dict()
     switches = "pq30" + triangle_area_switch(EQUILATERAL * case.size**2)
+    kw = options or {}
     return (
-        lambda: aftmesh.generate(poly, case.size),
+        lambda: aftmesh.generate(poly, case.size, **kw),
         lambda: triangle.triangulate(tri_dict, switches),
     )
 
@@ -424,15 +428,24 @@ def stage_medians(aft: Callable[[], object], calls: int) -> list[float]:
     return [statistics.median(column) for column in zip(*rows)]
 
 
-def run_real(budget: float, breakdown: bool, folder: Path = REALWORLD) -> None:
+# --bare: Basic_aft alone, without the passes after it (smoothing, the minimum-angle
+# pass): what the front itself costs against Triangle on real outlines
+BARE_OPTIONS = {"smooth": 0, "min_angle": None}
+
+
+def run_real(
+    budget: float, breakdown: bool, folder: Path = REALWORLD, options: dict | None = None
+) -> None:
     rows, per_tri = [], []
+    if options:
+        print("aftmesh options: " + ", ".join(f"{k}={v!r}" for k, v in options.items()))
     header = (
         f"{'case':<22}{'verts':>7}{'edge/h':>7}{'uniform':>8}{'aft tri':>8}{'Tri tri':>8}"
         f"{'aft ms':>9}{'tri ms':>9}{'ratio':>7}{'per tri':>8}"
     )
     print(header + ("  " + " ".join(TIMING_COLUMNS) + " (wall ms)" if breakdown else ""))
     for case in real_outlines(folder):
-        aft, tri = _runners(case)
+        aft, tri = _runners(case, options)
         t0 = time.process_time()
         mesh = aft()
         once = time.process_time() - t0
@@ -474,9 +487,14 @@ def main(argv=None) -> None:
     parser.add_argument(
         "--data", type=Path, default=REALWORLD, help="folder of outline .json files (--real)"
     )
+    parser.add_argument(
+        "--bare",
+        action="store_true",
+        help="real group: aftmesh without smoothing and the minimum-angle pass (Basic_aft alone)",
+    )
     args = parser.parse_args(argv)
     if args.real:
-        run_real(args.budget, not args.no_breakdown, args.data)
+        run_real(args.budget, not args.no_breakdown, args.data, BARE_OPTIONS if args.bare else None)
     else:
         run_overhead(args.calls)
 
