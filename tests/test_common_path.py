@@ -265,6 +265,17 @@ def test_common_case_declines_what_only_the_stages_report(monkeypatch):
     assert taken.declined == 3 and taken.taken == 0
 
 
+def test_common_case_with_edges_kept_whole_declines_what_only_the_stages_report(monkeypatch):
+    # formula (3) above max_triangles and the count estimate above the limit: the
+    # stages' messages (kept whole, no discretization refuses a boundary first)
+    taken = Taken(monkeypatch)
+    with pytest.raises(InvalidSizeError, match="formula"):
+        aftmesh.generate(STRIP, 0.1, max_triangles=3, split_boundary=False)
+    with pytest.raises(InvalidSizeError, match="asks for about"):
+        aftmesh.generate(box(0, 0, 1, 1), 1e-6, split_boundary=False)
+    assert taken.declined == 2 and taken.taken == 0
+
+
 def test_common_case_takes_boundaries_longer_than_the_cached_round_keys(monkeypatch, checked):
     # more boundary points than _order.CACHED_ROUNDS, in the background and after the
     # discretization: the compiled call draws the longer keys the stages draw
