@@ -1,6 +1,8 @@
 # generate's common case in one call: one polygon (holes allowed), polygons whose
 # rings meet nowhere, or a dict or .poly domain (with Triangle's hole and region
-# points or without), meshed at a constant size with the compiled subtasks, its input
+# points or without), meshed at a number size, at the input edges' sizes, or in a
+# size field made before (a callable's, by _stages.size_field) with the compiled
+# subtasks, its input
 # edges split by the size or kept whole (split_boundary=False: then they are the
 # boundary's pieces, and the minimum-angle pass splits none of them).
 #
@@ -123,6 +125,35 @@ cdef object _common_field(const double[:, ::1] v, const double* box, double res,
     if not finite:
         return False
     return pts_arr, u_arr, g_arr, tv, nb, spread - 1.0, rules[RULE_BOUNDARY_REACH]
+
+
+cdef object _edges_field(const double[:, ::1] vertices, const int32_t[:, ::1] segments,
+                         const double* box, double res, double constant, double gradation,
+                         const double[::1] rules, object rounds, bint split):
+    """_common_field from the sizes the input edges ask for at their vertices (the
+    shortest edge at each, or with split False the kept-whole sizes), on the vertices
+    on a segment: None, False or the field's arrays, as _common_field says."""
+    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0]
+    cdef double* short = <double*> malloc(n * sizeof(double))
+    cdef double* longest = NULL
+    cdef int32_t* ends = NULL
+    if not split:
+        longest = <double*> malloc(n * sizeof(double))
+        ends = <int32_t*> malloc(3 * n * sizeof(int32_t))
+    try:
+        if short == NULL or (not split and (longest == NULL or ends == NULL)):
+            raise MemoryError()
+        if split:
+            shortest_edges_into(&vertices[0, 0], n, &segments[0, 0], m, short)
+        else:   # the sizes _stages.size_field asks for with the edges kept whole
+            kept_edge_sizes_into(&vertices[0, 0], n, &segments[0, 0], m, short, longest,
+                                 ends)
+        return _common_field(_on_segments(vertices, short), box, res, constant, gradation,
+                             short, rules, rounds)
+    finally:
+        free(short)
+        free(longest)
+        free(ends)
 
 
 cdef object _on_segments(const double[:, ::1] v, double* short):
@@ -420,7 +451,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
                     int smooth_rounds, bint slide, double min_angle, bint scaffold,
-                    bint split=True):
+                    bint split=True, object given=None):
     """The stages of generate from the size field to the refined mesh, for a number
     size, `constant` (0: size=None, the input edges' lengths alone; see the top of
     pipeline.pxi).  classify: the domain is one valid polygon
@@ -435,17 +466,16 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     max_pieces: the most boundary pieces allowed; progress_limit: the triangle hint
     above which a progress bar may be wanted; slide: smoothing slides the boundary's
     split points along their input edges; min_angle 0: no pass; split: the input
-    edges are cut by the size (split_boundary), else kept whole.
+    edges are cut by the size (split_boundary), else kept whole; given: a size field
+    _stages.size_field made (a callable's, or a SizeField the caller passed), as its
+    kernel_args()[1:], used as it is (constant: its constant), else None.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
     counts or None, (t_boundary, t_cdt, t_aft) perf_counter times)."""
-    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0], i
+    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0]
     cdef double box[4]
     cdef double res
-    cdef double* short
-    cdef double* longest = NULL
-    cdef int32_t* ends = NULL
     cdef SizeField S
     if rules.shape[0] != N_RULES:
         raise ValueError(f"rules must hold {N_RULES} values")
@@ -460,30 +490,17 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
         return None
     box_of(&vertices[0, 0], n, box)
     res = _math_ulp(max(max(fabs(box[0]), fabs(box[1])), max(fabs(box[2]), fabs(box[3]))))
-    if constant and not constant >= rules[RULE_MIN_SIZE_ULPS] * res:
+    if given is None and constant and not constant >= rules[RULE_MIN_SIZE_ULPS] * res:
         return None
     if not area:
         area = max(box[2] - box[0], 1e-300) * max(box[3] - box[1], 1e-300)
-    short = <double*> malloc(n * sizeof(double))
-    if not split:
-        longest = <double*> malloc(n * sizeof(double))
-        ends = <int32_t*> malloc(3 * n * sizeof(int32_t))
-    try:
-        if short == NULL or (not split and (longest == NULL or ends == NULL)):
-            raise MemoryError()
-        if split:
-            shortest_edges_into(&vertices[0, 0], n, &segments[0, 0], m, short)
-        else:   # the sizes _stages.size_field asks for with the edges kept whole
-            kept_edge_sizes_into(&vertices[0, 0], n, &segments[0, 0], m, short, longest,
-                                 ends)
-        field = _common_field(_on_segments(vertices, short), box, res, constant, gradation,
-                              short, rules, rounds)
-    finally:
-        free(short)
-        free(longest)
-        free(ends)
-    if field is False:
-        return None
+    if given is not None:
+        field = None if len(given[3]) == 0 else given
+    else:
+        field = _edges_field(vertices, segments, box, res, constant, gradation, rules,
+                             rounds, split)
+        if field is False:
+            return None
     # one copy of the field serves the count, the discretization and the front, each
     # walking from the first background triangle as a fresh copy would
     memset(&S, 0, sizeof(SizeField))

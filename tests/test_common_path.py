@@ -329,15 +329,17 @@ def test_no_standard_error_draws_no_bar_and_raises_nothing(monkeypatch, checked)
     checked(aftmesh.generate(box(0, 0, 1, 1), lambda x, y: 0.05 + 0 * x))  # the stages
 
 
-def test_common_case_takes_only_plain_numbers_and_none(monkeypatch):
+def test_common_case_takes_plain_numbers_none_and_fields(monkeypatch):
     taken = _compare(monkeypatch, box(0, 0, 1, 1), np.float64(0.25))
     assert taken.taken == 0
     taken = _compare(monkeypatch, box(0, 0, 1, 1), 1)
     assert taken.taken == 1
     taken = _compare(monkeypatch, box(0, 0, 1, 1), lambda x, y: 0.2 + 0 * x)
-    assert taken.taken == 0
+    assert taken.taken == 1  # the stages' field of the callable, made first
     taken = _compare(monkeypatch, STRIP, None)
     assert taken.taken == 1
+    taken = _compare(monkeypatch, box(0, 0, 1, 1), [0.2])  # per region: the stages
+    assert taken.taken == taken.declined == 0
     for bad in (0, 0.0, -1.0, math.inf, math.nan):
         taken = Taken(monkeypatch)
         with pytest.raises(InvalidSizeError, match="finite and positive"):
@@ -345,7 +347,46 @@ def test_common_case_takes_only_plain_numbers_and_none(monkeypatch):
         assert taken.taken == taken.declined == 0  # the stages' message
 
 
-@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0, None]), st.booleans())
+def _graded(x, y):
+    # finer towards the origin, by a factor of 20 over the unit square
+    return 0.01 + 0.2 * np.hypot(x, y)
+
+
+@pytest.mark.parametrize("split", [True, False], ids=["split", "whole"])
+@pytest.mark.parametrize(
+    "domain", [STRIP, box(0, 0, 1, 1), FRAMED], ids=["strip", "square", "dict"]
+)
+def test_common_case_makes_the_stages_mesh_with_a_size_callable(
+    monkeypatch, checked, domain, split
+):
+    calls = []
+
+    def counted(x, y):
+        calls.append(len(x))
+        return _graded(x, y)
+
+    assert _compare(monkeypatch, domain, counted, checked, split_boundary=split).taken == 1
+    # each generate call builds the callable's field once: the stages' rounds
+    once = len(calls) // 2
+    assert once > 0 and calls[:once] == calls[once:]
+    mesh = aftmesh.generate(domain, _graded, split_boundary=split)
+    field = mesh.info["size_field"]
+    assert not field.is_constant and field.rate == pytest.approx(0.3)
+
+
+def test_common_case_takes_a_size_field_as_it_is(monkeypatch, checked):
+    # a field made before (a partitioned mesh's parts get the whole domain's): used
+    # as it is, constant or not, without deriving anything from the edges
+    graded = aftmesh.generate(STRIP, _graded).info["size_field"]
+    constant = aftmesh.generate(box(0, 0, 1, 1), 0.1).info["size_field"]
+    for field in (graded, constant):
+        for split in (True, False):
+            taken = _compare(monkeypatch, STRIP, field, checked, split_boundary=split)
+            assert taken.taken == 1
+    assert aftmesh.generate(STRIP, graded).info["size_field"] is graded
+
+
+@given(star_polygons(), st.sampled_from([0.05, 0.2, 1.0, None, _graded]), st.booleans())
 def test_common_case_makes_the_stages_mesh_on_random_polygons(poly, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
         _compare(monkeypatch, poly, size, split_boundary=split)
@@ -358,7 +399,9 @@ def test_common_case_makes_the_stages_mesh_next_to_a_short_edge(chamfer, size, s
         _compare(monkeypatch, corner, size, split_boundary=split)
 
 
-@given(polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4, None]), st.booleans())
+@given(
+    polygons_with_circular_holes(), st.sampled_from([0.03, 0.1, 0.4, None, _graded]), st.booleans()
+)
 def test_common_case_makes_the_stages_mesh_on_random_polygons_with_holes(poly, size, split):
     with pytest.MonkeyPatch.context() as monkeypatch:
         _compare(monkeypatch, poly, size, split_boundary=split)

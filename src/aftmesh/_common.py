@@ -79,17 +79,26 @@ def _is_plain_number(size) -> bool:
 
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size or
-    None (the input edges' lengths), the compiled subtasks (input edges split or kept
-    whole), no progress bar asked for, and one polygon (holes allowed, no constraint lines),
-    polygons whose rings meet nowhere, or a dict or .poly (Triangle's hole and region
-    points allowed)."""
+    None (the input edges' lengths), or a field (a size callable, or a SizeField) that
+    _stages.size_field makes first (see given_field), the compiled subtasks (input
+    edges split or kept whole), no progress bar asked for, and one polygon (holes
+    allowed, no constraint lines), polygons whose rings meet nowhere, or a dict or
+    .poly (Triangle's hole and region points allowed)."""
     return (
-        (size is None or _is_plain_number(size))
+        (size is None or _is_plain_number(size) or given_field(size))
         and opts.compiled
         and (opts.progress is None or opts.progress is False)
         and _plain_markers(dom.region_points)
         and (dom.polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom))
     )
+
+
+def given_field(size) -> bool:
+    """A size the compiled call takes as the field _stages.size_field makes of it (a
+    callable, the field itself when a SizeField), not as a number: generate builds
+    that field before the call, once, and hands it to the stages if the call
+    declines (the user's callable is not evaluated twice)."""
+    return callable(size) and not isinstance(size, (bool, np.bool_))
 
 
 def _plain_markers(region_points: np.ndarray | None) -> bool:
@@ -125,7 +134,13 @@ def _progress_limit(progress) -> float:
 
 def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> Mesh | None:
     """The Mesh of generate by the compiled call, or None where it declines (then
-    nothing has changed, and the stages run).  The caller checked `applies`."""
+    nothing has changed, and the stages run).  The caller checked `applies`; size is a
+    number, None, or the SizeField _stages.size_field made (given_field)."""
+    given = size.kernel_args()[1:] if isinstance(size, SizeField) else None
+    if given is not None:
+        constant = float(size.constant) if size.is_constant else 0.0
+    else:
+        constant = 0.0 if size is None else float(size)  # 0: the size from the input edges
     refining = bool(opts.min_angle) and not opts.greedy and opts.swaps
     seeds = dom.region_points if dom.region_points is not None and len(dom.region_points) else None
     cap, _ = opts.triangle_cap
@@ -139,7 +154,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         None if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
         None if seeds is None else _points(seeds[:, :2]),
         None if seeds is None else seeds[:, 2].astype(np.int32),
-        0.0 if size is None else float(size),  # 0: the size from the input edges
+        constant,
         float(opts.gradation),
         float(dom.area or 0.0),
         round_keys,
@@ -157,13 +172,16 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         float(opts.min_angle) if refining else 0.0,
         opts.scaffold,
         opts.split_boundary,
+        given,
     )
     if out is None:
         return None
     kernel, source, _n_boundary, n_merged, arrays, _expected, moves, done, times = out
     t_boundary, t_cdt, t_aft = times
-    constant = 0.0 if size is None else float(size)
-    field = SizeField(constant) if arrays is None else SizeField(constant, *arrays)
+    if given is not None:
+        field = size
+    else:
+        field = SizeField(constant) if arrays is None else SizeField(constant, *arrays)
     refined = None
     if done is not None:
         refined = {"bound": opts.min_angle, "reached": done["unresolved_triangles"] == 0, **done}

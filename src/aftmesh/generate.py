@@ -331,11 +331,17 @@ def generate(
     if len(dom.vertices) < 3:
         raise InvalidDomainError(f"the domain has {len(dom.vertices)} vertices: nothing to mesh")
     edge_tags = _stages.boundary_tags(dom, opts)
+    field = None
     if _common.applies(dom, size, opts):
-        mesh = _common.common_case(dom, size, opts, edge_tags, t_start)
+        # a callable's field is made once: for the compiled call, and for the stages
+        # if it declines
+        if _common.given_field(size):
+            field, expected = _stages.size_field(dom, size, opts.gradation, not opts.split_boundary)
+        mesh = _common.common_case(dom, size if field is None else field, opts, edge_tags, t_start)
         if mesh is not None:
             return mesh
-    field, expected = _stages.size_field(dom, size, opts.gradation, not opts.split_boundary)
+    if field is None:
+        field, expected = _stages.size_field(dom, size, opts.gradation, not opts.split_boundary)
     t_boundary = time.perf_counter()
     boundary = _stages.boundary_cdt(dom, field, opts, expected)
     kernel = _stages.prepare_front(boundary, dom, field, opts)
