@@ -213,8 +213,9 @@ def overhead_outline() -> Outline:
 def overhead_forms() -> dict[str, tuple[tuple, dict]]:
     """generate's arguments for the fixed-cost strip in the other forms users pass:
     without a size (the edges' sizes), as a multipolygon of three copies side by side,
-    as a Triangle dict with a square hole and its hole point, and with its input edges
-    kept whole (split_boundary=False, as the main table's aftmesh column meshes)."""
+    as a Triangle dict with a square hole and its hole point, with its input edges
+    kept whole (split_boundary=False, as the main table's aftmesh column meshes), and
+    at a size callable (strip_ramp)."""
     from shapely import affinity
     from shapely.geometry import MultiPolygon
 
@@ -239,7 +240,14 @@ def overhead_forms() -> dict[str, tuple[tuple, dict]]:
         f"{case.name}/x3": ((copies, case.size), {}),
         f"{case.name}/dict-hole": ((holed, case.size), {}),
         f"{case.name}/whole": ((poly, case.size), {"split_boundary": False}),
+        f"{case.name}/callable": ((poly, strip_ramp), {}),
     }
+
+
+def strip_ramp(x, y):
+    """The strip's size as a callable: its number size at the left end, growing by
+    half of it along the strip's 100 units (about the same triangle count)."""
+    return 0.8 + 0.004 * np.asarray(x)
 
 
 def real_outlines(folder: Path = REALWORLD) -> list[Outline]:

@@ -451,7 +451,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
                     int smooth_rounds, bint slide, double min_angle, bint scaffold,
-                    bint split=True, object given=None):
+                    bint split=True, object given=None, double given_expected=-1.0):
     """The stages of generate from the size field to the refined mesh, for a number
     size, `constant` (0: size=None, the input edges' lengths alone; see the top of
     pipeline.pxi).  classify: the domain is one valid polygon
@@ -468,7 +468,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     split points along their input edges; min_angle 0: no pass; split: the input
     edges are cut by the size (split_boundary), else kept whole; given: a size field
     _stages.size_field made (a callable's, or a SizeField the caller passed), as its
-    kernel_args()[1:], used as it is (constant: its constant), else None.
+    kernel_args()[1:], used as it is (constant: its constant), else None; given_expected:
+    the triangles it asks for as _stages.size_field counted them (< 0: count here).
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
@@ -509,7 +510,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                             ring_polygon, holes, seeds, seed_ids, constant, area, rules,
                             rounds, max_pieces, progress_limit, order, max_triangles,
                             min_area, close_factor, swaps, greedy, smooth_rounds, slide,
-                            min_angle, scaffold, split, n)
+                            min_angle, scaffold, split, given_expected, n)
     finally:
         size_field_free(&S)
 
@@ -524,9 +525,11 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
                          double max_pieces, double progress_limit, int order,
                          long long max_triangles, object min_area, double close_factor,
                          bint swaps, bint greedy, int smooth_rounds, bint slide,
-                         double min_angle, bint scaffold, bint split, Py_ssize_t n):
+                         double min_angle, bint scaffold, bint split,
+                         double expected_in, Py_ssize_t n):
     """generate_common from its size field on (field: _common_field's arrays, or None
-    for the constant), S the kernel's copy of it, which the triangulation takes."""
+    for the constant), S the kernel's copy of it, which the triangulation takes;
+    expected_in: the count of a given field, made already (< 0: none)."""
     cdef double expected, h_min, covered, share, hint_f, total
     cdef long long hint
     cdef Py_ssize_t nv
@@ -538,10 +541,13 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
     else:
         _field_of(S, constant, field[0], field[1], field[2], field[3], field[4], field[5],
                   field[6])
-        total = count_triangles_asked(S, rules[RULE_MIN_ESTIMATE_RATE],
-                                      rules[RULE_EQUILATERAL_AREA], &covered)
-        share = area / (covered if covered >= 1e-300 else 1e-300)
-        expected = total * (share if share < 1.0 else 1.0) * rules[RULE_ESTIMATE_MARGIN]
+        if expected_in >= 0:
+            expected = expected_in
+        else:
+            total = count_triangles_asked(S, rules[RULE_MIN_ESTIMATE_RATE],
+                                          rules[RULE_EQUILATERAL_AREA], &covered)
+            share = area / (covered if covered >= 1e-300 else 1e-300)
+            expected = total * (share if share < 1.0 else 1.0) * rules[RULE_ESTIMATE_MARGIN]
         h_min = _smallest_size(field[1], field[2])
     if not expected <= rules[RULE_MAX_TRIANGLES]:
         return None

@@ -132,10 +132,13 @@ def _progress_limit(progress) -> float:
     return math.inf if progress is False else _stages.default_bar_limit()
 
 
-def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> Mesh | None:
+def common_case(
+    dom: Domain, size, opts: Options, edge_tags, t_start: float, expected: float = -1.0
+) -> Mesh | None:
     """The Mesh of generate by the compiled call, or None where it declines (then
     nothing has changed, and the stages run).  The caller checked `applies`; size is a
-    number, None, or the SizeField _stages.size_field made (given_field)."""
+    number, None, or the SizeField _stages.size_field made (given_field), with the
+    triangles it asks for, `expected`, as that counted them."""
     given = size.kernel_args()[1:] if isinstance(size, SizeField) else None
     if given is not None:
         constant = float(size.constant) if size.is_constant else 0.0
@@ -173,6 +176,7 @@ def common_case(dom: Domain, size, opts: Options, edge_tags, t_start: float) -> 
         opts.scaffold,
         opts.split_boundary,
         given,
+        float(expected) if given is not None else -1.0,
     )
     if out is None:
         return None

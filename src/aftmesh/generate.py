@@ -333,11 +333,13 @@ def generate(
     edge_tags = _stages.boundary_tags(dom, opts)
     field = None
     if _common.applies(dom, size, opts):
-        # a callable's field is made once: for the compiled call, and for the stages
-        # if it declines
+        # a callable's field is made (and counted) once: for the compiled call, and for
+        # the stages if it declines
         if _common.given_field(size):
             field, expected = _stages.size_field(dom, size, opts.gradation, not opts.split_boundary)
-        mesh = _common.common_case(dom, size if field is None else field, opts, edge_tags, t_start)
+            mesh = _common.common_case(dom, field, opts, edge_tags, t_start, expected)
+        else:
+            mesh = _common.common_case(dom, size, opts, edge_tags, t_start)
         if mesh is not None:
             return mesh
     if field is None:
