@@ -1,10 +1,10 @@
 # generate's common case in one call: one polygon (holes allowed), polygons whose
 # rings meet nowhere, or a dict or .poly domain (with Triangle's hole and region
-# points or without), meshed at a number size, at the input edges' sizes, or in a
-# size field made before (a callable's, by _stages.size_field) with the compiled
-# subtasks, its input
-# edges split by the size or kept whole (split_boundary=False: then they are the
-# boundary's pieces, and the minimum-angle pass splits none of them).
+# points or without), meshed with the compiled subtasks at a number size, at the
+# input edges' sizes, or in a size field made before (a callable's, by
+# _stages.size_field), its input edges split by the size or kept whole
+# (split_boundary=False: then they are the boundary's pieces, and the minimum-angle
+# pass splits none of them).
 #
 # It is the data flow of _stages.py (size field, count, discretization, boundary CDT,
 # front, smoothing, minimum-angle pass) with the glue between the kernel calls in C

@@ -98,7 +98,7 @@ def given_field(size) -> bool:
     callable, the field itself when a SizeField), not as a number: generate builds
     that field before the call, once, and hands it to the stages if the call
     declines (the user's callable is not evaluated twice)."""
-    return callable(size) and not isinstance(size, (bool, np.bool_))
+    return callable(size)
 
 
 def _plain_markers(region_points: np.ndarray | None) -> bool:
