@@ -1264,15 +1264,9 @@ def shortest_edges(const double[:, ::1] xy, const int32_t[:, ::1] seg,
     _check_pslg(xy, seg)
     out_arr = np.empty(n, dtype=np.float64)
     cdef double[::1] out = out_arr
-    cdef double[::1] longest
-    cdef int32_t[::1] ends
-    if n and kept_whole:
-        longest = np.empty(n, dtype=np.float64)
-        ends = np.empty(3 * n, dtype=np.int32)
-        kept_edge_sizes_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0],
-                             &longest[0], &ends[0])
-    elif n:
-        shortest_edges_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0])
+    if n and edge_sizes_into(&xy[0, 0], n, &seg[0, 0] if m else NULL, m, &out[0],
+                             kept_whole):
+        raise MemoryError()
     return out_arr
 
 

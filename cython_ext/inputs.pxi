@@ -6,6 +6,7 @@
 #
 # Uses: libc, and orient2d from predicates.pxi (rings_are_proper); no triangulation.
 from libc.math cimport INFINITY, fabs, isfinite, sqrt
+from libc.stdlib cimport malloc, free
 from libc.stdint cimport int32_t, int64_t, uint64_t
 
 # Bits of coordinate_flags / segment_flags.
@@ -297,6 +298,25 @@ cdef void kept_edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* se
         # with two segments at v, the shortest and longest are their two lengths
         if ux * wx + uy * wy < KEPT_MEAN_MIN_COS * out[v] * longest[v]:
             out[v] = sqrt(out[v]) * sqrt(longest[v])
+
+
+cdef int edge_sizes_into(const double* xy, Py_ssize_t n, const int32_t* seg,
+                         Py_ssize_t m, double* out, bint kept_whole) noexcept nogil:
+    """out[v] = the size input vertex v asks for: the shortest segment at v
+    (shortest_edges_into), or with the segments kept whole kept_edge_sizes_into's
+    (its scratch allocated here).  0, or -1 when out of memory."""
+    cdef double* longest
+    cdef int32_t* ends
+    if not kept_whole:
+        shortest_edges_into(xy, n, seg, m, out)
+        return 0
+    longest = <double*> malloc(n * sizeof(double))
+    ends = <int32_t*> malloc(3 * n * sizeof(int32_t))
+    if longest != NULL and ends != NULL:
+        kept_edge_sizes_into(xy, n, seg, m, out, longest, ends)
+    free(longest)
+    free(ends)
+    return 0 if longest != NULL and ends != NULL else -1
 
 
 cdef int take_into(const int32_t* table, Py_ssize_t n, const int32_t* index, Py_ssize_t m,

@@ -133,27 +133,16 @@ cdef object _edges_field(const double[:, ::1] vertices, const int32_t[:, ::1] se
     """_common_field from the sizes the input edges ask for at their vertices (the
     shortest edge at each, or with split False the kept-whole sizes), on the vertices
     on a segment: None, False or the field's arrays, as _common_field says."""
-    cdef Py_ssize_t n = vertices.shape[0], m = segments.shape[0]
+    cdef Py_ssize_t n = vertices.shape[0]
     cdef double* short = <double*> malloc(n * sizeof(double))
-    cdef double* longest = NULL
-    cdef int32_t* ends = NULL
-    if not split:
-        longest = <double*> malloc(n * sizeof(double))
-        ends = <int32_t*> malloc(3 * n * sizeof(int32_t))
     try:
-        if short == NULL or (not split and (longest == NULL or ends == NULL)):
+        if short == NULL or edge_sizes_into(&vertices[0, 0], n, &segments[0, 0],
+                                            segments.shape[0], short, not split):
             raise MemoryError()
-        if split:
-            shortest_edges_into(&vertices[0, 0], n, &segments[0, 0], m, short)
-        else:   # the sizes _stages.size_field asks for with the edges kept whole
-            kept_edge_sizes_into(&vertices[0, 0], n, &segments[0, 0], m, short, longest,
-                                 ends)
         return _common_field(_on_segments(vertices, short), box, res, constant, gradation,
                              short, rules, rounds)
     finally:
         free(short)
-        free(longest)
-        free(ends)
 
 
 cdef object _on_segments(const double[:, ::1] v, double* short):
@@ -454,22 +443,22 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     bint split=True, object given=None, double given_expected=-1.0):
     """The stages of generate from the size field to the refined mesh, for a number
     size, `constant` (0: size=None, the input edges' lengths alone; see the top of
-    pipeline.pxi).  classify: the domain is one valid polygon
-    with holes, its rings the sources (edge_source: the source of each input edge),
-    the exterior ring source 0; or, with ring_polygon (an int32 array: the polygon of
-    each source ring), a valid multipolygon whose rings meet nowhere, its pieces
-    classified by how they nest (domain.pxi's nested_regions).  holes, seeds and
-    seed_ids: Triangle's hole points and region points with their ids (float64
-    (h, 2), (r, 2) and int32 (r,) arrays, or None for none), as pslg.build_cdt
-    applies them.  rounds: _order.round_keys,
-    called for the BRIO round keys of the background's and the boundary's points;
-    max_pieces: the most boundary pieces allowed; progress_limit: the triangle hint
-    above which a progress bar may be wanted; slide: smoothing slides the boundary's
-    split points along their input edges; min_angle 0: no pass; split: the input
-    edges are cut by the size (split_boundary), else kept whole; given: a size field
-    _stages.size_field made (a callable's, or a SizeField the caller passed), as its
-    kernel_args()[1:], used as it is (constant: its constant), else None; given_expected:
-    the triangles it asks for as _stages.size_field counted them (< 0: count here).
+    pipeline.pxi).  classify: the domain is one valid polygon with holes, its rings
+    the sources (edge_source: the source of each input edge), the exterior ring
+    source 0; or, with ring_polygon (an int32 array: the polygon of each source
+    ring), a valid multipolygon whose rings meet nowhere, its pieces classified by how
+    they nest (domain.pxi's nested_regions).  holes, seeds and seed_ids: Triangle's
+    hole points and region points with their ids (float64 (h, 2), (r, 2) and int32
+    (r,) arrays, or None for none), as pslg.build_cdt applies them.  rounds:
+    _order.round_keys, called for the BRIO round keys of the background's and the
+    boundary's points; max_pieces: the most boundary pieces allowed; progress_limit:
+    the triangle hint above which a progress bar may be wanted; slide: smoothing
+    slides the boundary's split points along their input edges; min_angle 0: no
+    pass; split: the input edges are cut by the size (split_boundary), else kept
+    whole; given: a size field _stages.size_field made (a callable's, or a SizeField
+    the caller passed), as its kernel_args()[1:], used as it is (constant: its
+    constant), else None; given_expected: the triangles it asks for as
+    _stages.size_field counted them (< 0: count here).
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
