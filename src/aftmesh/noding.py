@@ -124,13 +124,24 @@ def merge_and_node(
     counts = {"snapped": 0}
     segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    if exact_valid:
+    if exact_valid or _proved_uncrossed(uniq, segs):
         out = uniq, segs, src
     else:
         out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
     if report is not None and tolerance > 0:
         report.update(merged=n_merged, snapped=counts["snapped"])
     return out
+
+
+def _proved_uncrossed(verts: np.ndarray, segs: np.ndarray) -> bool:
+    """The kernel's grid test (crossings.pxi) proves that no two segments cross at a
+    point inside both, as node_crossings would find in its first round (shapely's
+    "crosses" on segments split at every vertex on them): node_crossings would then
+    change nothing, and its tree search and relate tests are skipped."""
+    if len(segs) < 2:
+        return True
+    xy = np.ascontiguousarray(verts, dtype=np.float64)
+    return segments_cross(xy, np.ascontiguousarray(segs, dtype=np.int64)) == 0
 
 
 def unique_rows(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
