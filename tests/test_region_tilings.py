@@ -166,3 +166,150 @@ def test_crossing_proof_leaves_the_domain_node_crossings_makes(polygons, monkeyp
     for name in ("vertices", "segments", "segment_edge", "edge_source"):
         assert np.array_equal(getattr(kept, name), getattr(noded, name)), name
     assert kept.cleanup == noded.cleanup
+
+
+# ----------------------------------------------------- constraint lines and points
+# The input side of a domain with many constraint lines or fixed points works on all
+# of them at once; these references are the one-by-one forms it replaced.
+
+
+def _reference_line_chain(coords):
+    c = np.asarray(coords, dtype=np.float64)
+    keep = np.ones(len(c), dtype=bool)
+    keep[:-1] = (c[:-1] != c[1:]).any(axis=1)
+    mid = 0.5 * (c[:-1] + c[1:])
+    return c[keep], np.flatnonzero(keep), max(len(c) - 1, 0), mid
+
+
+def _reference_with_lines(rings, lines, line_names, points):
+    verts, segs, edges, source, mids, names = rings
+    names = list(names)
+    verts, segs, edges, source, mids = [verts], [segs], [edges], [source], [mids]
+    n_vertices, n_edges = len(verts[0]), len(mids[0])
+    for line, name in zip(lines, line_names):
+        c, ids, n, mid = _reference_line_chain(np.asarray(line.coords)[:, :2])
+        source.append(np.full(n, len(names)))
+        names.append(name)
+        mids.append(mid)
+        if len(c) >= 2:
+            idx = np.arange(len(c))
+            verts.append(c)
+            segs.append(np.c_[idx[:-1], idx[1:]] + n_vertices)
+            edges.append(ids[: len(c) - 1] + n_edges)
+            n_vertices += len(c)
+        elif len(c):
+            verts.append(c)
+            n_vertices += 1
+        n_edges += n
+    if points:
+        verts.append(np.concatenate([np.asarray(p.coords)[:, :2] for p in points]))
+    cat = np.concatenate
+    return cat(verts), cat(segs), cat(edges), cat(source), cat(mids), names
+
+
+coordinate = st.integers(0, 4).map(float)
+line_coords = st.lists(st.tuples(coordinate, coordinate), min_size=2, max_size=6)
+
+
+@given(st.lists(line_coords, min_size=1, max_size=6), st.integers(0, 3))
+def test_lines_taken_together_as_one_by_one(lines_xy, n_points):
+    """Repeated vertices (runs, whole lines at one place) included."""
+    from shapely.geometry import LineString, Point
+
+    rings = inputs._ring_arrays([box(-1, -1, 6, 6)], ["the polygon"], [])
+    lines = [LineString(c) for c in lines_xy]
+    names = [f"constraint line {k}" for k in range(len(lines))]
+    points = [Point(k, 0.5) for k in range(n_points)]
+    got = inputs._with_lines(rings, lines, names, points)
+    want = _reference_with_lines(rings, lines, names, points)
+    for a, b in zip(got[:5], want[:5]):
+        assert np.array_equal(a, b) and a.dtype == b.dtype
+    assert got[5] == want[5]
+
+
+def test_collection_parts_are_sorted_and_named_as_before():
+    from shapely.geometry import (
+        GeometryCollection,
+        LinearRing,
+        LineString,
+        MultiLineString,
+        MultiPoint,
+        MultiPolygon,
+        Point,
+    )
+
+    parts = [
+        box(0, 0, 10, 10),
+        LineString([(1, 1), (2, 2)]),
+        MultiLineString([[(3, 1), (4, 2)], [(5, 1), (6, 2)]]),
+        MultiPoint([(7, 7), (8, 8)]),
+        MultiLineString([[(1, 5), (2, 5)]]),
+        MultiPolygon([box(20, 0, 21, 1), box(22, 0, 23, 1)]),
+        LinearRing([(1, 8), (2, 8), (2, 9)]),
+        Point(9, 9),
+    ]
+    polygons, lines, names, points = inputs._split_geometry(GeometryCollection(parts))
+    assert [p.bounds for p in polygons] == [
+        (0, 0, 10, 10),
+        (20, 0, 21, 1),
+        (22, 0, 23, 1),
+    ]
+    assert names == [
+        "constraint line 0",
+        "part 0 of constraint line 1",
+        "part 1 of constraint line 1",
+        "constraint line 2",
+        "constraint line 3",
+    ]
+    assert [np.asarray(x.coords).tolist() for x in lines][1] == [[3, 1], [4, 2]]
+    assert [p.coords[0] for p in points] == [(7, 7), (8, 8), (9, 9)]
+    with pytest.raises(aftmesh.InvalidDomainError, match="cannot mesh a GeometryCollection"):
+        inputs._split_geometry(GeometryCollection([box(0, 0, 1, 1), GeometryCollection(parts)]))
+
+
+def _reference_node_crossings(verts, segs, src):
+    """One round of node_crossings as it was: the crossing points pair by pair, each
+    segment cut at its points one segment at a time."""
+    from shapely.geometry import Point
+
+    lines, pairs = noding._crossing_pairs(verts, segs)
+    base, extra, cuts = len(verts), [], {}
+    for i, j in pairs.T:
+        for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
+            if isinstance(p, Point):
+                extra.append(np.asarray(p.coords)[0, :2])
+                cuts.setdefault(int(i), []).append(base + len(extra) - 1)
+                cuts.setdefault(int(j), []).append(base + len(extra) - 1)
+    if not extra:
+        return verts, segs, src
+    verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
+    out_s, out_src = [], []
+    for k in range(len(segs)):
+        if k not in cuts:
+            out_s.append(segs[k][None, :])
+            out_src.append([src[k]])
+            continue
+        chain = noding._chain(verts, segs[k], cuts[k])
+        out_s.append(np.c_[chain[:-1], chain[1:]])
+        out_src.append([src[k]] * (len(chain) - 1))
+    return verts, np.concatenate(out_s).astype(np.int64), np.concatenate(out_src).astype(np.int64)
+
+
+@given(st.lists(st.tuples(coordinate, coordinate, coordinate, coordinate), min_size=2, max_size=8))
+def test_crossings_found_together_as_pair_by_pair(quads):
+    """Segments on a small grid of coordinates: crossings, three segments through one
+    point, overlaps and shared ends."""
+    xy = np.array([[q[0], q[1], q[2], q[3]] for q in quads]).reshape(-1, 2)
+    verts, inverse = noding.unique_rows(xy)
+    segs = inverse.reshape(-1, 2).astype(np.int64)
+    segs = segs[segs[:, 0] != segs[:, 1]]
+    if len(segs) < 2:
+        return
+    src = np.arange(len(segs), dtype=np.int64)
+    lines, pairs = noding._crossing_pairs(verts, segs)
+    extra, cuts = noding._crossing_points(lines, pairs, len(verts))
+    got_v = np.concatenate([verts, extra]) if len(extra) else verts
+    got_s, got_src = noding._cut(got_v, segs, src, cuts) if len(extra) else (segs, src)
+    want_v, want_s, want_src = _reference_node_crossings(verts, segs, src)
+    assert np.array_equal(got_v, want_v)
+    assert np.array_equal(got_s, want_s) and np.array_equal(got_src, want_src)

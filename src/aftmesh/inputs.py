@@ -19,11 +19,7 @@ import numpy as np
 import shapely
 from shapely.geometry import (
     GeometryCollection,
-    LineString,
-    MultiLineString,
-    MultiPoint,
     MultiPolygon,
-    Point,
     Polygon,
 )
 
@@ -108,42 +104,51 @@ def _ring_names(names: list[str], holes: list[int]) -> list[str]:
     return out
 
 
-def _line_chain(coords: np.ndarray):
-    """A line's distinct vertices, each with the index of its outgoing input edge."""
-    c = np.asarray(coords, dtype=np.float64)
-    keep = np.ones(len(c), dtype=bool)
-    keep[:-1] = (c[:-1] != c[1:]).any(axis=1)
-    mid = 0.5 * (c[:-1] + c[1:])
-    return c[keep], np.flatnonzero(keep), max(len(c) - 1, 0), mid
-
-
 def _with_lines(rings: tuple, lines: list, line_names: list[str], points: list):
     """The rings' arrays (see _ring_arrays) with the constraint lines' vertices,
     segments and input edges appended, then the fixed points' vertices."""
     verts, segs, edges, source, mids, names = rings
+    names = list(names)
     if not lines and not points:
-        return verts, segs, edges, source, mids, list(names)
-    verts, segs, edges, source, mids = [verts], [segs], [edges], [source], [mids]
-    n_vertices, n_edges = len(verts[0]), len(mids[0])
-    for line, name in zip(lines, line_names):
-        c, ids, n, mid = _line_chain(np.asarray(line.coords)[:, :2])
-        source.append(np.full(n, len(names)))
-        names.append(name)
-        mids.append(mid)
-        if len(c) >= 2:
-            idx = np.arange(len(c))
-            verts.append(c)
-            segs.append(np.c_[idx[:-1], idx[1:]] + n_vertices)
-            edges.append(ids[: len(c) - 1] + n_edges)
-            n_vertices += len(c)
-        elif len(c):  # all its vertices at one place: a fixed point, as a Point is
-            verts.append(c)
-            n_vertices += 1
-        n_edges += n
+        return verts, segs, edges, source, mids, names
+    if lines:
+        line = _line_arrays(lines, len(verts), len(mids), len(names))
+        verts, segs, edges, source, mids = (
+            np.concatenate([a, b]) for a, b in zip((verts, segs, edges, source, mids), line)
+        )
+        names.extend(line_names)
     if points:
-        verts.append(np.concatenate([np.asarray(p.coords)[:, :2] for p in points]))
-    cat = np.concatenate
-    return cat(verts), cat(segs), cat(edges), cat(source), cat(mids), names
+        verts = np.concatenate([verts, shapely.get_coordinates(points)])
+    return verts, segs, edges, source, mids, names
+
+
+def _line_arrays(lines: list, n_vertices: int, n_edges: int, n_sources: int):
+    """All constraint lines at once, numbered on from the rings' n_vertices vertices,
+    n_edges input edges and n_sources sources: their vertices (a run of repeated
+    vertices kept once, as its last copy, so each keeps the input edge that leaves
+    the run, as in a ring; a line whose vertices are all at one place is a fixed
+    point), segments, the input edge of each segment, the source of each input edge
+    and each input edge's midpoint."""
+    coords, line_of = shapely.get_coordinates(lines, return_index=True)
+    per_line = np.bincount(line_of, minlength=len(lines))
+    first = np.zeros(len(lines) + 1, dtype=np.int64)
+    first[1:] = np.cumsum(per_line)
+    last = np.zeros(len(coords), dtype=bool)
+    last[first[1:][per_line > 0] - 1] = True  # a line's last coordinate
+    keep = last.copy()
+    keep[:-1] |= (coords[:-1] != coords[1:]).any(axis=1)
+    inner = ~last[:-1]  # pairs of consecutive coordinates of one line: its input edges
+    mids = (0.5 * (coords[:-1] + coords[1:]))[inner]
+    n_line_edges = np.maximum(per_line - 1, 0)
+    source = np.repeat(np.arange(len(lines), dtype=np.int64) + n_sources, n_line_edges)
+    edge_base = np.zeros(len(lines), dtype=np.int64)
+    edge_base[1:] = np.cumsum(n_line_edges)[:-1]
+    kept_line = line_of[keep]
+    kept_edge = (np.arange(len(coords)) - first[line_of])[keep] + edge_base[kept_line] + n_edges
+    chained = kept_line[:-1] == kept_line[1:]  # consecutive kept vertices of one line
+    ids = np.arange(len(kept_line), dtype=np.int64) + n_vertices
+    segs = np.c_[ids[:-1], ids[1:]][chained]
+    return coords[keep], segs, kept_edge[:-1][chained], source, mids
 
 
 def _from_shapely(
@@ -257,29 +262,43 @@ def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
     )
 
 
+# shapely's type ids of the parts a domain may have, by what they become
+POLYGON_TYPES = (3, 6)  # Polygon, MultiPolygon
+LINE_TYPES = (1, 2, 5)  # LineString, LinearRing, MultiLineString
+POINT_TYPES = (0, 4)  # Point, MultiPoint
+MULTI_LINE = 5
+
+
 def _split_geometry(domain):
-    """A shapely geometry's polygons, constraint lines (with their names) and points."""
-    polygons, lines, line_names, points = [], [], [], []
-    parts = shapely.get_parts(domain) if isinstance(domain, GeometryCollection) else [domain]
-    n_lines = 0
-    for part in parts:
-        if isinstance(part, (Polygon, MultiPolygon)):
-            polygons.extend(polygon_parts(part, "the domain"))
-        elif isinstance(part, (LineString, MultiLineString)):
-            pieces = list(shapely.get_parts(part))
-            for j, piece in enumerate(pieces):
-                lines.append(piece)
-                line_names.append(
-                    f"constraint line {n_lines}"
-                    if len(pieces) == 1 or isinstance(part, LineString)
-                    else f"part {j} of constraint line {n_lines}"
-                )
-            n_lines += 1
-        elif isinstance(part, (Point, MultiPoint)):
-            points.extend(shapely.get_parts(part))
-        else:
-            raise InvalidDomainError(f"cannot mesh a {part.geom_type}")
-    return polygons, lines, line_names, points
+    """A shapely geometry's polygons, constraint lines (with their names) and points.
+    A collection's parts are sorted by type all at once, not one by one (a domain
+    may carry thousands of lines or points)."""
+    if not isinstance(domain, GeometryCollection):
+        if isinstance(domain, (Polygon, MultiPolygon)):
+            return polygon_parts(domain, "the domain"), [], [], []
+        parts = np.empty(1, dtype=object)
+        parts[0] = domain
+    else:
+        parts = shapely.get_parts(domain)
+    kinds = shapely.get_type_id(parts)
+    unknown = np.flatnonzero(~np.isin(kinds, POLYGON_TYPES + LINE_TYPES + POINT_TYPES))
+    if len(unknown):
+        raise InvalidDomainError(f"cannot mesh a {parts[unknown[0]].geom_type}")
+    polygons = list(shapely.get_parts(parts[np.isin(kinds, POLYGON_TYPES)]))
+    points = list(shapely.get_parts(parts[np.isin(kinds, POINT_TYPES)]))
+    is_line = np.isin(kinds, LINE_TYPES)
+    lines, owner = shapely.get_parts(parts[is_line], return_index=True)
+    count = np.bincount(owner, minlength=int(is_line.sum()))
+    start = np.zeros(len(count), dtype=np.int64)
+    start[1:] = np.cumsum(count)[:-1]
+    # a line's pieces are "part j of constraint line n" only when a MultiLineString
+    # has several; n counts the line parts, even one with no piece
+    plain = (count == 1) | (kinds[is_line] != MULTI_LINE)
+    line_names = [
+        f"constraint line {n}" if plain[n] else f"part {j} of constraint line {n}"
+        for n, j in zip(owner.tolist(), (np.arange(len(lines)) - start[owner]).tolist())
+    ]
+    return polygons, list(lines), line_names, points
 
 
 def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 import shapely
-from shapely.geometry import Point
 
 from ._kernel import (
     CollinearError,
@@ -26,6 +25,9 @@ from ._kernel import (
 )
 from ._order import brio_order
 from .errors import CrossingSegmentsError
+
+# shapely's type id of a Point
+POINT_TYPE = 0
 
 __all__ = [
     "snap_tolerance",
@@ -124,7 +126,7 @@ def merge_and_node(
     counts = {"snapped": 0}
     segs, src = split_at_vertices(uniq, segs, src, note, tol, ring_source, counts)
     segs, src = _drop_repeats(segs, src)
-    if exact_valid or _proved_uncrossed(uniq, segs):
+    if exact_valid:
         out = uniq, segs, src
     else:
         out = node_crossings(uniq, segs, src, note, tol, ring_source=ring_source)
@@ -135,9 +137,9 @@ def merge_and_node(
 
 def _proved_uncrossed(verts: np.ndarray, segs: np.ndarray) -> bool:
     """The kernel's grid test (crossings.pxi) proves that no two segments cross at a
-    point inside both, as node_crossings would find in its first round (shapely's
-    "crosses" on segments split at every vertex on them): node_crossings would then
-    change nothing, and its tree search and relate tests are skipped."""
+    point inside both, as a round of node_crossings would find (shapely's "crosses" on
+    segments split at every vertex on them): the round would change nothing, so its
+    tree search and relate tests are skipped."""
     if len(segs) < 2:
         return True
     xy = np.ascontiguousarray(verts, dtype=np.float64)
@@ -258,24 +260,16 @@ def node_crossings(
         tol = snap_tolerance(verts)
     n_cut = 0
     for _ in range(rounds):
-        if len(segs) < 2:
+        if _proved_uncrossed(verts, segs):
             break
         lines, pairs = _crossing_pairs(verts, segs)
         if pairs.shape[1] == 0:
             break
-        base = len(verts)
-        extra = []
-        cuts: dict[int, list[int]] = {}
-        for i, j in pairs.T:
-            for p in shapely.get_parts(shapely.intersection(lines[i], lines[j])):
-                if isinstance(p, Point):
-                    extra.append(np.asarray(p.coords)[0, :2])
-                    cuts.setdefault(int(i), []).append(base + len(extra) - 1)
-                    cuts.setdefault(int(j), []).append(base + len(extra) - 1)
-        if not extra:
+        extra, cuts = _crossing_points(lines, pairs, len(verts))
+        if not len(extra):
             break
         n_cut += pairs.shape[1]
-        verts = np.concatenate([verts, np.array(extra).reshape(-1, 2)])
+        verts = np.concatenate([verts, extra])
         segs, src = _cut(verts, segs, src, cuts)
         verts, inverse = unique_rows(verts)
         segs = inverse[segs]
@@ -286,33 +280,50 @@ def node_crossings(
     return verts, segs, src
 
 
+def _crossing_points(lines, pairs, base: int) -> tuple[np.ndarray, dict[int, list[int]]]:
+    """The points where the crossing pairs of lines meet (all intersections in one
+    vectorized call, pair by pair in order, each pair's points in GEOS's order), and
+    for each segment the numbers of the points on it, counted on from `base`."""
+    meet = shapely.intersection(lines[pairs[0]], lines[pairs[1]])
+    parts, pair = shapely.get_parts(meet, return_index=True)
+    is_point = shapely.get_type_id(parts) == POINT_TYPE
+    extra = shapely.get_coordinates(parts[is_point]).reshape(-1, 2)
+    cuts: dict[int, list[int]] = {}
+    for n, k in enumerate(pair[is_point].tolist()):
+        cuts.setdefault(int(pairs[0, k]), []).append(base + n)
+        cuts.setdefault(int(pairs[1, k]), []).append(base + n)
+    return extra, cuts
+
+
 def _cut(pts, segs, src, cuts):
     """Replace each segment k in `cuts` by the chain through the vertices cuts[k],
-    ordered along it."""
-    out_s, out_src = [], []
-    for k in range(len(segs)):
-        if k not in cuts:
-            out_s.append(segs[k][None, :])
-            out_src.append([src[k]])
-            continue
-        a, b = segs[k]
-        # order the cut points along the segment by the coordinate along which it runs
-        # furthest, then the other: comparing coordinates is exact, whereas a dot
-        # product would round away the order of points closer than its ulp
-        d = pts[b] - pts[a]
-        major = 0 if abs(d[0]) >= abs(d[1]) else 1
-        sign = np.where(d >= 0, 1.0, -1.0)
-        inner = sorted(
-            set(cuts[k]) - {a, b},
-            key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]),
-        )
-        chain = [a, *inner, b]
-        out_s.append(np.c_[chain[:-1], chain[1:]])
-        out_src.append([src[k]] * (len(chain) - 1))
-    return (
-        np.concatenate(out_s).astype(np.int64),
-        np.concatenate([np.asarray(x) for x in out_src]).astype(np.int64),
+    ordered along it (the segments not cut are copied as they are, in bulk)."""
+    chains = {k: _chain(pts, segs[k], cuts[k]) for k in sorted(cuts)}
+    rows = np.ones(len(segs), dtype=np.int64)
+    for k, chain in chains.items():
+        rows[k] = len(chain) - 1
+    out_s = np.repeat(np.asarray(segs, dtype=np.int64), rows, axis=0)
+    out_src = np.repeat(np.asarray(src, dtype=np.int64), rows)
+    start = np.cumsum(rows) - rows
+    for k, chain in chains.items():
+        out_s[start[k] : start[k] + rows[k]] = np.c_[chain[:-1], chain[1:]]
+    return out_s, out_src
+
+
+def _chain(pts, seg, on: list[int]) -> list[int]:
+    """The segment's ends with the vertices `on` it between them, ordered along it."""
+    a, b = int(seg[0]), int(seg[1])
+    # order the cut points along the segment by the coordinate along which it runs
+    # furthest, then the other: comparing coordinates is exact, whereas a dot
+    # product would round away the order of points closer than its ulp
+    d = pts[b] - pts[a]
+    major = 0 if abs(d[0]) >= abs(d[1]) else 1
+    sign = np.where(d >= 0, 1.0, -1.0)
+    inner = sorted(
+        set(on) - {a, b},
+        key=lambda v: (sign[major] * pts[v][major], sign[1 - major] * pts[v][1 - major]),
     )
+    return [a, *inner, b]
 
 
 def _drop_repeats(segs, src):

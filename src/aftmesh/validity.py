@@ -160,9 +160,12 @@ def check_lines_inside(
     if union is None:
         union = shapely.union_all(polygons)
     tol = None
-    for line, name in zip(lines, line_names):
-        if union.covers(line):
-            continue
+    # one vectorized test for all the lines (and points), then the few outside
+    outside: list[int] = (
+        np.flatnonzero(~shapely.covers(union, list(lines))).tolist() if lines else []
+    )
+    for k in outside:
+        line, name = lines[k], line_names[k]
         if tol is None:
             tol = max(
                 tolerance,
@@ -175,8 +178,9 @@ def check_lines_inside(
             raise InvalidDomainError(
                 f"{name} is not inside the domain: it leaves the domain at {_xy(*p)}"
             )
-    for k, p in enumerate(points):
-        if not union.covers(p):
-            raise InvalidDomainError(
-                f"fixed point {k} = {list(p.coords)[0]} is not inside the domain"
-            )
+    stray: list[int] = (
+        np.flatnonzero(~shapely.covers(union, list(points))).tolist() if points else []
+    )
+    for k in stray:
+        p = points[k]
+        raise InvalidDomainError(f"fixed point {k} = {list(p.coords)[0]} is not inside the domain")
