@@ -313,3 +313,33 @@ def test_crossings_found_together_as_pair_by_pair(quads):
     want_v, want_s, want_src = _reference_node_crossings(verts, segs, src)
     assert np.array_equal(got_v, want_v)
     assert np.array_equal(got_s, want_s) and np.array_equal(got_src, want_src)
+
+
+def _nan_region():
+    with np.errstate(invalid="ignore"):  # shapely warns as it builds the ring
+        return Polygon([(17, 0), (18, float("nan")), (18, 1)])
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        (lambda: Polygon([(17, 0), (18, 1), (18, 0), (17, 1)]), r"region 12 is not a valid"),
+        (lambda: Polygon([(17, 0), (18, 0), (19, 0)]), r"region 12 is not a valid polygon: the"),
+        (Polygon, r"region 12 is empty"),
+        (_nan_region, r"region 12, exterior ring: vertex 1"),
+    ],
+    ids=["bowtie", "flat", "empty", "nan"],
+)
+def test_bad_region_among_many_named_as_alone(bad, message):
+    """Many regions are checked all at once; a bad one is still named as
+    check_polygon names it, and before a later region that is not a polygon."""
+    regions = grid(4)[:12] + [bad()] + grid(4)[12:]
+    with pytest.raises(aftmesh.InvalidDomainError, match=message):
+        aftmesh.generate(regions, 0.5)
+    with pytest.raises(aftmesh.InvalidDomainError, match=message):
+        aftmesh.generate([*regions, "not a polygon"], 0.5)
+
+
+def test_region_that_is_not_a_polygon_after_many_named():
+    with pytest.raises(aftmesh.InvalidDomainError, match="region 16 is a str"):
+        aftmesh.generate([*grid(4), "not a polygon"], 0.5)

@@ -28,7 +28,7 @@ from ._typing import DomainArg
 from .domain_record import Domain
 from .errors import InvalidDomainError
 from .noding import merge_and_node
-from .pslg import MAX_COORDINATE, MIN_COORDINATE, check_range
+from .pslg import COORDINATE_NOT_FINITE, MAX_COORDINATE, MIN_COORDINATE, check_range
 from .pslg_input import from_dict, from_poly_file
 from .repair import repair_domain
 from .validity import check_lines_inside, check_polygon
@@ -363,6 +363,32 @@ def _region_polygon(k: int, item):
     raise InvalidDomainError(f"region {k} is a {type(item).__name__}, expected a polygon")
 
 
+def _check_parts(parts: list, names: list[str]) -> None:
+    """check_polygon of each part, in order.  Many parts are first looked at all at
+    once (coordinates, validity, area): when none has a problem, none is looked at
+    again; else the parts are checked one by one, so the first problem is named as
+    check_polygon names it."""
+    if len(parts) > FEW_POLYGONS and _plainly_fine(parts):
+        return
+    for part, name in zip(parts, names):
+        check_polygon(part, name)
+
+
+def _plainly_fine(parts: list) -> bool:
+    """Every part passes check_polygon: not empty, x and y only and finite, valid, of
+    positive area (its tests, vectorized)."""
+    geoms = np.empty(len(parts), dtype=object)
+    geoms[:] = parts
+    if not (shapely.get_num_coordinates(geoms) > 0).all():
+        return False
+    if not (shapely.get_coordinate_dimension(geoms) == 2).all():
+        return False
+    coords = shapely.get_coordinates(geoms)
+    if coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE) & COORDINATE_NOT_FINITE:
+        return False
+    return bool(shapely.is_valid(geoms).all() and (shapely.area(geoms) > 0).all())
+
+
 def first_overlap(polygons: list) -> tuple[int, int, float] | None:
     """The first pair of regions i < j (ordered by i, then j) whose common area is
     more than REGION_OVERLAP of the smaller one's, with that area; None if none.  Only
@@ -398,12 +424,20 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
     """A sequence of polygons with disjoint interiors: one region each."""
     if not items:
         raise InvalidDomainError("the domain is an empty sequence")
-    polygons = []
+    polygons: list = []
+    flat: list[Polygon] = []
+    names: list[str] = []
     for k, item in enumerate(items):
-        poly = _region_polygon(k, item)
-        for part in polygon_parts(poly, f"region {k}"):
-            check_polygon(part, f"region {k}")
+        try:
+            poly = _region_polygon(k, item)
+            parts = polygon_parts(poly, f"region {k}")
+        except InvalidDomainError:
+            _check_parts(flat, names)  # an earlier region's problem is named first
+            raise
         polygons.append(poly)
+        flat += parts
+        names += [f"region {k}"] * len(parts)
+    _check_parts(flat, names)
     found = first_overlap(polygons)
     if found is not None:
         i, j, overlap = found
@@ -411,12 +445,6 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
             f"regions {i} and {j} overlap (common area {overlap:.6g}): regions must "
             "have disjoint interiors"
         )
-    flat: list[Polygon] = []
-    names: list[str] = []
-    for k, p in enumerate(polygons):
-        for part in polygon_parts(p, f"region {k}"):
-            flat.append(part)
-            names.append(f"region {k}")
     dom = _from_shapely(
         flat, [], [], [], names, tolerance, area=float(sum(p.area for p in polygons))
     )
