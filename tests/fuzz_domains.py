@@ -1170,6 +1170,50 @@ def nested_regions(draw):
 
 
 @st.composite
+def parcels(draw):
+    """Region lists of many parcels: Voronoi cells of random points clipped to a box
+    (neighbours share their edges exactly), or a grid of rectangles of random widths
+    row by row (T-junctions), up to a few dozen regions."""
+    if draw(st.booleans()):
+        n = draw(st.integers(3, 40))
+        seeds = [(draw(_finite_floats(0, 2)), draw(_finite_floats(0, 1))) for _ in range(n)]
+        frame = box(0, 0, 2, 1)
+        cells = shapely.get_parts(
+            shapely.voronoi_polygons(shapely.MultiPoint(seeds), extend_to=frame)
+        )
+        regions = [c for c in shapely.intersection(cells, frame) if isinstance(c, Polygon)]
+        assume(len(regions) >= 2 and all(_valid(r) and r.area > 1e-6 for r in regions))
+        return "parcels-voronoi", regions
+    regions = []
+    rows = draw(st.integers(2, 6))
+    for j in range(rows):
+        cuts = sorted(set(draw(st.lists(_finite_floats(0.02, 0.98), min_size=1, max_size=8))))
+        xs = [0.0, *cuts, 1.0]
+        regions += [box(a, j / rows, b, (j + 1) / rows) for a, b in zip(xs[:-1], xs[1:])]
+    assume(all(_valid(r) for r in regions))
+    return "parcels-rows", regions
+
+
+@st.composite
+def many_constraints(draw):
+    """A polygon with many short constraint lines (a few of them crossing) and many
+    fixed points: the input side takes them all at once."""
+    W = draw(_finite_floats(1.0, 3.0))
+    poly = box(0, 0, W, 1)
+    lines, points = [], []
+    for _ in range(draw(st.integers(5, 40))):
+        x, y = draw(_finite_floats(0.1, W - 0.1)), draw(_finite_floats(0.1, 0.9))
+        dx, dy = draw(_finite_floats(-0.08, 0.08)), draw(_finite_floats(-0.08, 0.08))
+        line = LineString([(x, y), (x + dx, y + dy)])
+        if line.length > 0:
+            lines.append(line)
+    for _ in range(draw(st.integers(0, 40))):
+        points.append(Point(draw(_finite_floats(0.05, W - 0.05)), draw(_finite_floats(0.05, 0.95))))
+    assume(lines)
+    return "many-constraints", GeometryCollection([poly, *lines, *points])
+
+
+@st.composite
 def extreme_scales(draw):
     """A valid domain scaled by 10**k, k from -70 to 80: far beyond what the exact
     predicates can handle at both ends, where the only right answers are a correct
@@ -1194,6 +1238,8 @@ GENERATORS = {
     "cocircular": cocircular(),
     "constraints": with_constraints(),
     "regions": nested_regions(),
+    "parcels": parcels(),
+    "many-constraints": many_constraints(),
     "extreme": extreme_scales(),
 }
 
