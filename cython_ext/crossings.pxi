@@ -1,9 +1,9 @@
 # Whether two segments of an input cross at a point inside both: the check of a dict or
 # .poly input (noding.refuse_crossings) before anything is split, and the proof that
-# lets noding.merge_and_node skip the noding of rings that do not cross.  Most inputs
-# have no crossing, and proving that needs no triangulation: two segments that cross
-# share a cell of nearby.pxi's grid (the crossing point is inside both boxes, and a box
-# is registered in every cell it overlaps), so each cell's pairs are tested, by exact
+# ends noding.node_crossings's rounds once no two segments cross.  Most inputs have no
+# crossing, and proving that needs no triangulation: two segments that cross share a
+# cell of nearby.pxi's grid (the crossing point is inside both boxes, and a box is
+# registered in every cell it overlaps), so each cell's pairs are tested, by exact
 # orient2d.  Only when a crossing is found does the caller build the CDT that names it
 # (or noding.node_crossings split it).
 #

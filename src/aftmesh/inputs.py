@@ -41,6 +41,10 @@ REGION_OVERLAP = 1e-12
 # Up to this many polygons, their rings are taken one polygon at a time: shapely's
 # vectorized get_rings costs about 10 us however few there are.
 FEW_POLYGONS = 16
+# Above this many regions, they are checked all at once and their overlaps looked for
+# with a tree; below it, one by one and pair by pair cost less than the vectorized
+# calls' own setup.
+MANY_REGIONS = 8
 
 
 def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str], coords=None):
@@ -368,7 +372,7 @@ def _check_parts(parts: list, names: list[str]) -> None:
     once (coordinates, validity, area): when none has a problem, none is looked at
     again; else the parts are checked one by one, so the first problem is named as
     check_polygon names it."""
-    if len(parts) > FEW_POLYGONS and _plainly_fine(parts):
+    if len(parts) > MANY_REGIONS and _plainly_fine(parts):
         return
     for part, name in zip(parts, names):
         check_polygon(part, name)
@@ -399,8 +403,8 @@ def first_overlap(polygons: list) -> tuple[int, int, float] | None:
         return None
     geoms = np.empty(len(polygons), dtype=object)
     geoms[:] = polygons
-    if len(polygons) <= FEW_POLYGONS:
-        i, j = np.triu_indices(len(polygons), 1)  # a tree costs more than it saves
+    if len(polygons) <= MANY_REGIONS:
+        i, j = np.triu_indices(len(polygons), 1)
     else:
         i, j = shapely.STRtree(geoms).query(geoms)
         pairs = i < j
