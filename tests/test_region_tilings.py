@@ -343,3 +343,25 @@ def test_bad_region_among_many_named_as_alone(bad, message):
 def test_region_that_is_not_a_polygon_after_many_named():
     with pytest.raises(aftmesh.InvalidDomainError, match="region 16 is a str"):
         aftmesh.generate([*grid(4), "not a polygon"], 0.5)
+
+
+@given(
+    st.lists(st.integers(-3, 3), min_size=6, max_size=6),
+    st.tuples(st.integers(-3, 3), st.integers(-3, 3)),
+)
+def test_probes_not_inside_as_one_by_one(ints, probe):
+    """Flat triangles, probes on an edge or a corner, outside or strictly inside."""
+    from aftmesh._kernel import py_orient2d
+
+    corners = np.array(ints, dtype=np.float64).reshape(1, 3, 2) / 3.0
+    probes = np.array([probe], dtype=np.float64) / 3.0
+    (ax, ay), (bx, by), (cx, cy) = corners[0].tolist()
+    x, y = probes[0].tolist()
+    side = py_orient2d(ax, ay, bx, by, cx, cy)
+    inside = (
+        side != 0
+        and py_orient2d(ax, ay, bx, by, x, y) == side
+        and py_orient2d(bx, by, cx, cy, x, y) == side
+        and py_orient2d(cx, cy, ax, ay, x, y) == side
+    )
+    assert regions._probes_not_inside(probes, corners).tolist() == ([] if inside else [0])

@@ -13,7 +13,7 @@ from fractions import Fraction
 import numpy as np
 import shapely
 
-from ._kernel import py_orient2d
+from ._kernel import orient2d_many
 
 __all__ = ["classify_pieces"]
 
@@ -81,21 +81,19 @@ def _ring_coordinates(poly) -> list[np.ndarray]:
 
 
 def _probes_not_inside(probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """The pieces whose probe is not strictly inside its triangle (exact orient2d)."""
-    unsure = []
-    # Python floats: the same doubles, without a numpy scalar per coordinate
-    for c, (((ax, ay), (bx, by), (cx, cy)), (x, y)) in enumerate(
-        zip(corners.tolist(), probes.tolist())
-    ):
-        side = py_orient2d(ax, ay, bx, by, cx, cy)
-        if not (
-            side != 0
-            and py_orient2d(ax, ay, bx, by, x, y) == side
-            and py_orient2d(bx, by, cx, cy, x, y) == side
-            and py_orient2d(cx, cy, ax, ay, x, y) == side
-        ):
-            unsure.append(c)
-    return np.array(unsure, dtype=np.intp)
+    """The pieces whose probe is not strictly inside its triangle: the triangle is
+    flat, or the probe is not on the inner side of each edge (exact orient2d, all the
+    pieces in one kernel call)."""
+    n = len(probes)
+    if n == 0:
+        return np.zeros(0, dtype=np.intp)
+    pts = np.ascontiguousarray(np.concatenate([corners.reshape(-1, 2), probes]), dtype=np.float64)
+    a = 3 * np.arange(n, dtype=np.int32)
+    b, c, p = a + 1, a + 2, np.arange(n, dtype=np.int32) + 3 * n
+    rows = np.concatenate([np.c_[a, b, c], np.c_[a, b, p], np.c_[b, c, p], np.c_[c, a, p]])
+    side = orient2d_many(pts, np.ascontiguousarray(rows, dtype=np.int32)).reshape(4, n)
+    inside = (side[0] != 0) & (side[1] == side[0]) & (side[2] == side[0]) & (side[3] == side[0])
+    return np.flatnonzero(~inside)
 
 
 def _first_containing(geoms: np.ndarray, tree, probes: np.ndarray) -> np.ndarray:
