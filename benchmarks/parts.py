@@ -10,8 +10,7 @@ timed call by call in turns), their ratio and generate's per-stage breakdown
   points clipped to the unit square, and the same cells with each cell's edges split
   on its own (``shapely.segmentize``), so that neighbours' shared edges differ by
   rounding: slivers and near crossings, as digitized parcel data has them (Triangle
-  stops there with "Ran out of precision", printed on its standard output, and the
-  row shows aftmesh alone);
+  stops there with "Ran out of precision", and the row shows aftmesh alone);
 * a square with short constraint lines (one per cell of a grid), with a grid of
   long lines crossing each other (noded by aftmesh), and with random fixed points
   (a ``GeometryCollection`` each).
@@ -26,7 +25,10 @@ what it costs as the number of parts grows.  Nothing here is asserted.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import statistics
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -177,6 +179,21 @@ def _runners(case: Parts) -> tuple[Callable[[], object], Callable[[], object]]:
     )
 
 
+@contextlib.contextmanager
+def _quiet_stdout():
+    """Standard output silenced at the file descriptor: Triangle prints its errors
+    from C, past Python's sys.stdout."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as null:
+            os.dup2(null.fileno(), 1)
+            yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
 def _cpu(fn: Callable[[], object]) -> float:
     t0 = time.process_time()
     fn()
@@ -194,7 +211,8 @@ def run(budget: float) -> None:
         n_parts = len(case.regions) if case.regions else len(case.domain.geoms) - 1  # type: ignore[attr-defined]
         runs: Callable[[], object] | None = tri
         try:
-            n_tri = str(len(tri()["triangles"]))  # type: ignore[index]
+            with _quiet_stdout():
+                n_tri = str(len(tri()["triangles"]))  # type: ignore[index]
         except RuntimeError:  # Triangle's "Ran out of precision" on the slivers
             n_tri, runs = "fails", None
         calls = _calls_for(_cpu(aft), budget)
