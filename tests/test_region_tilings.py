@@ -365,3 +365,20 @@ def test_probes_not_inside_as_one_by_one(ints, probe):
         and py_orient2d(cx, cy, ax, ay, x, y) == side
     )
     assert regions._probes_not_inside(probes, corners).tolist() == ([] if inside else [0])
+
+
+def test_bad_part_among_many_parts_named_as_alone():
+    """A multipolygon's (or a collection's) many parts are checked all at once too; a
+    bad part is still named as check_polygon names it."""
+    from shapely.geometry import GeometryCollection, LineString, MultiPolygon
+
+    parts = [box(2 * i, 0, 2 * i + 1, 1) for i in range(12)]
+    bowtie = Polygon([(30, 0), (31, 1), (31, 0), (30, 1)])
+    with pytest.raises(aftmesh.InvalidDomainError, match="polygon 5 is not a valid polygon"):
+        aftmesh.generate(MultiPolygon(parts[:5] + [bowtie] + parts[5:]), 0.5)
+    with pytest.raises(aftmesh.InvalidDomainError, match="polygon 12 is not a valid polygon"):
+        aftmesh.generate(
+            GeometryCollection([*parts, bowtie, LineString([(0.2, 0.5), (0.8, 0.5)])]), 0.5
+        )
+    mesh = aftmesh.generate(MultiPolygon(parts), 0.5)
+    check_mesh(mesh, domain_area=12.0)

@@ -317,7 +317,11 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     # is those parts again, and only its area is used
     multi = MultiPolygon(polygons) if len(polygons) > 1 and not lines and not points else None
     parts_valid = multi is not None and bool(shapely.is_valid(multi))
-    checked = [check_polygon(p, names[k], parts_valid) for k, p in enumerate(polygons)]
+    checked = (
+        []
+        if len(polygons) > MANY_REGIONS and _plainly_fine(polygons, parts_valid)
+        else [check_polygon(p, names[k], parts_valid) for k, p in enumerate(polygons)]
+    )
     # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
     # copy), so it is not computed: check_polygon's validity holds for what is meshed
     valid = len(polygons) == 1 or parts_valid
@@ -378,9 +382,10 @@ def _check_parts(parts: list, names: list[str]) -> None:
         check_polygon(part, name)
 
 
-def _plainly_fine(parts: list) -> bool:
-    """Every part passes check_polygon: not empty, x and y only and finite, valid, of
-    positive area (its tests, vectorized)."""
+def _plainly_fine(parts: list, known_valid: bool = False) -> bool:
+    """Every part passes check_polygon (with `known_valid`, as check_polygon takes it):
+    not empty, x and y only and finite, valid, of positive area (its tests,
+    vectorized)."""
     geoms = np.empty(len(parts), dtype=object)
     geoms[:] = parts
     if not (shapely.get_num_coordinates(geoms) > 0).all():
@@ -390,7 +395,9 @@ def _plainly_fine(parts: list) -> bool:
     coords = shapely.get_coordinates(geoms)
     if coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE) & COORDINATE_NOT_FINITE:
         return False
-    return bool(shapely.is_valid(geoms).all() and (shapely.area(geoms) > 0).all())
+    if not (known_valid or shapely.is_valid(geoms).all()):
+        return False
+    return bool((shapely.area(geoms) > 0).all())
 
 
 def first_overlap(polygons: list) -> tuple[int, int, float] | None:
