@@ -1178,9 +1178,13 @@ def parcels(draw):
         n = draw(st.integers(3, 40))
         seeds = [(draw(_finite_floats(0, 2)), draw(_finite_floats(0, 1))) for _ in range(n)]
         frame = box(0, 0, 2, 1)
-        cells = shapely.get_parts(
-            shapely.voronoi_polygons(shapely.MultiPoint(seeds), extend_to=frame)
-        )
+        try:
+            diagram = shapely.voronoi_polygons(shapely.MultiPoint(seeds), extend_to=frame)
+        except shapely.errors.GEOSException:
+            # GEOS's own Voronoi fails on some near-degenerate seeds (a side location
+            # conflict): no domain to draw, not aftmesh's failure
+            assume(False)
+        cells = shapely.get_parts(diagram)
         regions = [c for c in shapely.intersection(cells, frame) if isinstance(c, Polygon)]
         assume(len(regions) >= 2 and all(_valid(r) and r.area > 1e-6 for r in regions))
         return "parcels-voronoi", regions
