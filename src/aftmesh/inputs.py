@@ -28,10 +28,10 @@ from ._typing import DomainArg
 from .domain_record import Domain
 from .errors import InvalidDomainError
 from .noding import merge_and_node
-from .pslg import COORDINATE_NOT_FINITE, MAX_COORDINATE, MIN_COORDINATE, check_range
+from .pslg import MAX_COORDINATE, MIN_COORDINATE, check_range
 from .pslg_input import from_dict, from_poly_file
 from .repair import repair_domain
-from .validity import check_lines_inside, check_polygon
+from .validity import MANY_POLYGONS, check_lines_inside, check_polygon, check_polygons
 
 __all__ = ["Domain", "to_domain"]
 
@@ -41,10 +41,6 @@ REGION_OVERLAP = 1e-12
 # Up to this many polygons, their rings are taken one polygon at a time: shapely's
 # vectorized get_rings costs about 10 us however few there are.
 FEW_POLYGONS = 16
-# Above this many regions, they are checked all at once and their overlaps looked for
-# with a tree; below it, one by one and pair by pair cost less than the vectorized
-# calls' own setup.
-MANY_REGIONS = 8
 
 
 def _ring_arrays(polygons: list[Polygon], names: list[str], note: list[str], coords=None):
@@ -317,11 +313,7 @@ def from_geometry(domain: shapely.Geometry, tolerance: float = 0.0) -> Domain:
     # is those parts again, and only its area is used
     multi = MultiPolygon(polygons) if len(polygons) > 1 and not lines and not points else None
     parts_valid = multi is not None and bool(shapely.is_valid(multi))
-    checked = (
-        []
-        if len(polygons) > MANY_REGIONS and _plainly_fine(polygons, parts_valid)
-        else [check_polygon(p, names[k], parts_valid) for k, p in enumerate(polygons)]
-    )
+    checked = check_polygons(polygons, names, parts_valid)
     # the union of one polygon is that polygon, vertex for vertex (GEOS returns a
     # copy), so it is not computed: check_polygon's validity holds for what is meshed
     valid = len(polygons) == 1 or parts_valid
@@ -371,35 +363,6 @@ def _region_polygon(k: int, item):
     raise InvalidDomainError(f"region {k} is a {type(item).__name__}, expected a polygon")
 
 
-def _check_parts(parts: list, names: list[str]) -> None:
-    """check_polygon of each part, in order.  Many parts are first looked at all at
-    once (coordinates, validity, area): when none has a problem, none is looked at
-    again; else the parts are checked one by one, so the first problem is named as
-    check_polygon names it."""
-    if len(parts) > MANY_REGIONS and _plainly_fine(parts):
-        return
-    for part, name in zip(parts, names):
-        check_polygon(part, name)
-
-
-def _plainly_fine(parts: list, known_valid: bool = False) -> bool:
-    """Every part passes check_polygon (with `known_valid`, as check_polygon takes it):
-    not empty, x and y only and finite, valid, of positive area (its tests,
-    vectorized)."""
-    geoms = np.empty(len(parts), dtype=object)
-    geoms[:] = parts
-    if not (shapely.get_num_coordinates(geoms) > 0).all():
-        return False
-    if not (shapely.get_coordinate_dimension(geoms) == 2).all():
-        return False
-    coords = shapely.get_coordinates(geoms)
-    if coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE) & COORDINATE_NOT_FINITE:
-        return False
-    if not (known_valid or shapely.is_valid(geoms).all()):
-        return False
-    return bool((shapely.area(geoms) > 0).all())
-
-
 def first_overlap(polygons: list) -> tuple[int, int, float] | None:
     """The first pair of regions i < j (ordered by i, then j) whose common area is
     more than REGION_OVERLAP of the smaller one's, with that area; None if none.  Only
@@ -410,7 +373,7 @@ def first_overlap(polygons: list) -> tuple[int, int, float] | None:
         return None
     geoms = np.empty(len(polygons), dtype=object)
     geoms[:] = polygons
-    if len(polygons) <= MANY_REGIONS:
+    if len(polygons) <= MANY_POLYGONS:
         i, j = np.triu_indices(len(polygons), 1)
     else:
         i, j = shapely.STRtree(geoms).query(geoms)
@@ -443,12 +406,12 @@ def from_regions(items: list, tolerance: float = 0.0) -> Domain:
             poly = _region_polygon(k, item)
             parts = polygon_parts(poly, f"region {k}")
         except InvalidDomainError:
-            _check_parts(flat, names)  # an earlier region's problem is named first
+            check_polygons(flat, names)  # an earlier region's problem is named first
             raise
         polygons.append(poly)
         flat += parts
         names += [f"region {k}"] * len(parts)
-    _check_parts(flat, names)
+    check_polygons(flat, names)
     found = first_overlap(polygons)
     if found is not None:
         i, j, overlap = found

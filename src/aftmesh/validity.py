@@ -20,7 +20,12 @@ from .errors import InvalidDomainError
 from .noding import snap_tolerance
 from .pslg import COORDINATE_NOT_FINITE, MAX_COORDINATE, MIN_COORDINATE
 
-__all__ = ["check_lines_inside", "check_polygon"]
+__all__ = ["check_lines_inside", "check_polygon", "check_polygons"]
+
+# Above this many polygons (regions, a multipolygon's parts), they are checked all at
+# once and their overlaps looked for with a tree; below it, one by one and pair by
+# pair cost less than the vectorized calls' own setup.
+MANY_POLYGONS = 8
 
 _WHERE = re.compile(r"\[([-+0-9.eEinfa]+) ([-+0-9.eEinfa]+)\]")
 
@@ -110,6 +115,35 @@ def check_polygon(poly: Polygon, where: str, known_valid: bool = False) -> tuple
         coords = np.asarray(poly.exterior.coords)
         raise InvalidDomainError(f"{where} has zero area (vertices {coords[:4].tolist()}...)")
     return coords, area
+
+
+def check_polygons(
+    polygons: Sequence[Polygon], names: Sequence[str], known_valid: bool = False
+) -> list[tuple[np.ndarray, float]]:
+    """check_polygon of each polygon, in order, and their results.  Many polygons are
+    first looked at all at once (coordinates, validity unless known, area): when none
+    has a problem, none is looked at again and the result is empty; else they are
+    checked one by one, so the first problem is named as check_polygon names it."""
+    if len(polygons) > MANY_POLYGONS and _plainly_fine(polygons, known_valid):
+        return []
+    return [check_polygon(p, name, known_valid) for p, name in zip(polygons, names)]
+
+
+def _plainly_fine(polygons: Sequence[Polygon], known_valid: bool) -> bool:
+    """Every polygon passes check_polygon: not empty, x and y only and finite, valid
+    (unless known), of positive area (its tests, vectorized)."""
+    geoms = np.empty(len(polygons), dtype=object)
+    geoms[:] = polygons
+    if not (shapely.get_num_coordinates(geoms) > 0).all():
+        return False
+    if not (shapely.get_coordinate_dimension(geoms) == 2).all():
+        return False
+    coords = shapely.get_coordinates(geoms)
+    if coordinate_problems(coords, MIN_COORDINATE, MAX_COORDINATE) & COORDINATE_NOT_FINITE:
+        return False
+    if not (known_valid or shapely.is_valid(geoms).all()):
+        return False
+    return bool((shapely.area(geoms) > 0).all())
 
 
 def _outside_by_rounding(outside, union, tol: float) -> bool:
