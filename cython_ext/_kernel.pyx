@@ -1120,9 +1120,10 @@ def rings_proved_valid(const double[:, ::1] pts, const int64_t[:, ::1] seg,
     """Whether ring_chains' output (points, segments, input edge of each segment, ring
     of each input edge) is proved a valid polygon or multipolygon, polygon k owning
     rings first_ring[k] (its exterior) to first_ring[k + 1] - 1: rings simple, meeting
-    nowhere, holes inside their exterior and outside each other, a polygon inside
-    another only within a hole (see simple_rings.pxi).  False means not proved, not
-    invalid."""
+    at most at common vertices where none crosses another and a polygon's own
+    touches close no cycle, holes inside their exterior and outside each other, a
+    polygon inside another only within a hole (see simple_rings.pxi).  False means
+    not proved, not invalid."""
     cdef Py_ssize_t n = pts.shape[0], m = seg.shape[0], k
     cdef Py_ssize_t n_polys = first_ring.shape[0] - 1
     cdef int res

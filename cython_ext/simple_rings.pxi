@@ -1,32 +1,41 @@
 # Whether a polygon's rings are a valid polygon (or a multipolygon's, a valid
 # multipolygon), proved without GEOS: every ring simple (at least three vertices, no two
 # of its edges meeting but consecutive ones at their common vertex, and those not
-# folding back), no two rings meeting anywhere, every hole inside its exterior ring and
-# outside its polygon's other holes, and a polygon inside another's exterior only within
-# one of its holes.  Rings that meet nowhere leave each interior connected, so such a
-# polygon is valid in the OGC sense shapely and GEOS use; what this cannot prove (rings
-# touching at a point, which can be valid too, or a search past its caps) is left to
-# GEOS, which then also names what is wrong.
+# folding back), two rings meeting at most at common vertices (a touch: a point that is
+# a vertex of both, where neither crosses the other and no edge of one runs along an
+# edge of the other), the touches between a polygon's own rings forming no cycle (a
+# hole touching the exterior twice, or a chain of holes touching from the exterior
+# back to it, would cut the interior in two), every hole inside its exterior ring and
+# outside its polygon's other holes, and a polygon inside another's exterior only
+# within one of its holes.  Such a polygon is valid in the OGC sense shapely and GEOS
+# use; what this cannot prove (a vertex on another ring's edge, a ring touching
+# itself, a search past its caps) is left to GEOS, which then also names what is wrong.
 #
-# Two closed segments that meet overlap in x and in y, so a sweep along the longer side
-# of the points' box tests each segment, by exact orient2d, against the segments whose
-# range along it overlaps its own and whose box meets its box: the ones the sweep line
-# stabs, a few on the rings people draw.  A hole's place is the crossing number of a
-# ray from its first vertex, by exact orient2d and exact comparisons of y: with the
-# rings apart, the vertex lies on no edge, so the count is never ambiguous.
+# Two closed segments that meet have a point in both of their boxes, so they share a
+# cell of a grid of about one cell a segment (nearby.pxi), and each cell's pairs are
+# tested by exact orient2d: a few a cell on the rings people draw.  At a touch, a ring
+# does not cross another when both of its edges there leave into the same one of the
+# two angles the other's edges make (exact orient2d).  A ring's place is the crossing
+# number of a ray from one of its vertices that touches nothing, counted for every
+# ring at once over the segments of the ray's horizontal band (by exact orient2d and
+# exact comparisons of y): that vertex lies on no other ring, so no count is
+# ambiguous, and a ring that meets another only at touches where it does not cross
+# it lies wholly on one side.
 #
-# Uses: inputs.pxi (box_of); predicates.pxi (orient2d).
-from libc.stdint cimport int64_t
-from libc.stdlib cimport malloc, free
+# Uses: inputs.pxi (box_of); predicates.pxi (orient2d); nearby.pxi (_Grid, _grid_build);
+# background.pxi (int64_order).
+from libc.stdint cimport int64_t, uint8_t
+from libc.stdlib cimport malloc, realloc, free, qsort
 
-# Segment pairs tested per segment before leaving the proof to GEOS: the sweep line
-# stabs a few segments of a drawn ring, but a comb of many parallel teeth would make
-# the sweep quadratic.
+# Segment pairs tested per segment before leaving the proof to GEOS: a grid cell holds
+# a few segments of the rings people draw, but many segments through one cell (a fan
+# of edges from one vertex) would make the search quadratic.
 cdef int64_t PROOF_TESTS_PER_SEGMENT = 32
-# The placement tests (rings times segments) allowed before leaving the proof to GEOS:
-# quadratic in the rings, so a polygon with thousands of holes (or a multipolygon of
-# thousands of parts) is not looked at ring by ring (GEOS's own index handles it).
-cdef int64_t RING_TESTS_MAX = 250_000
+# The placement's work allowed per segment (band entries, and the segments tested
+# against the rays of the rings' vertices) before leaving the proof to GEOS: a few
+# per segment on the rings people draw, but a thousand holes stacked along one
+# horizontal line would each test the others' segments.
+cdef int64_t PLACEMENT_TESTS_PER_SEGMENT = 64
 
 
 cdef inline bint _on_span(const double* a, const double* b, const double* c) noexcept nogil:
@@ -61,29 +70,6 @@ cdef inline bint _folds_back(const double* a, const double* b, const double* c) 
     return (a[1] < b[1]) == (c[1] < b[1]) or c[1] == b[1]
 
 
-cdef int _inside_ring(const double* xy, const int64_t* seg, Py_ssize_t s0, Py_ssize_t s1,
-                      const double* p) noexcept nogil:
-    """Whether p is inside the ring of segments s0..s1 - 1: the parity of the edges
-    crossing the ray from p towards +x (an edge counts when one end lies above p's y
-    and the other not).  1 inside, 0 outside, -1 when p is on an edge (the rings
-    met after all: nothing is proved)."""
-    cdef Py_ssize_t k
-    cdef const double* a
-    cdef const double* b
-    cdef int inside = 0, o
-    for k in range(s0, s1):
-        a = &xy[2 * seg[2 * k]]
-        b = &xy[2 * seg[2 * k + 1]]
-        if (a[1] > p[1]) != (b[1] > p[1]):
-            o = orient2d(a, b, p)
-            if o == 0:
-                return -1
-            # p left of the edge taken upwards: the crossing is to p's right
-            if (o > 0) == (b[1] > a[1]):
-                inside ^= 1
-    return inside
-
-
 cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ring,
                       Py_ssize_t m, Py_ssize_t n_rings, Py_ssize_t* start) noexcept nogil:
     """start[r] .. start[r + 1]: ring r's segments (segment k's ring: ring[edge[k]]),
@@ -113,7 +99,7 @@ cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ri
 
 
 cdef inline Py_ssize_t _slab(double x, double base, double scale, Py_ssize_t last) noexcept nogil:
-    # the sweep's slab of coordinate x: a monotone function of x (a rounded
+    # the band of coordinate x: a monotone function of x (a rounded
     # subtraction, a product with a positive number, a truncation, a clamp), so that
     # a range ending in an earlier slab than another begins ends before it
     cdef double t = (x - base) * scale
@@ -124,86 +110,99 @@ cdef inline Py_ssize_t _slab(double x, double base, double scale, Py_ssize_t las
     return <Py_ssize_t> t
 
 
+cdef struct Touches:
+    # The touches the search found: pairs of vertices of two rings at one point (a
+    # pair once for each pair of their edges, so up to four times).
+    int64_t* pair
+    Py_ssize_t n, cap
+
+
+cdef inline bint _same_point(const double* xy, int64_t i, int64_t j) noexcept nogil:
+    return xy[2 * i] == xy[2 * j] and xy[2 * i + 1] == xy[2 * j + 1]
+
+
+cdef int _touch(const double* xy, const int64_t* seg, const int64_t* seg_ring,
+                Py_ssize_t k, Py_ssize_t q, Touches* found) noexcept nogil:
+    """Segments k and q, known to meet: 1 when they are of different rings and meet
+    only at an end of both, a point (found gets the two vertices there), 0 when they
+    meet otherwise, -1 when out of memory."""
+    cdef int64_t i = -1, j = -1, a, b, c, d
+    cdef int shared = 0, ai, bj
+    cdef int64_t* grown
+    if seg_ring[k] == seg_ring[q]:
+        return 0
+    for ai in range(2):
+        for bj in range(2):
+            if _same_point(xy, seg[2 * k + ai], seg[2 * q + bj]):
+                shared += 1
+                i = seg[2 * k + ai]
+                j = seg[2 * q + bj]
+                a = seg[2 * k + 1 - ai]
+                b = seg[2 * q + 1 - bj]
+    if shared != 1:
+        return 0        # an end on the other's inside, or a crossing, or one edge twice
+    if _runs_along(&xy[2 * i], &xy[2 * a], &xy[2 * b]):
+        return 0
+    if found.n == found.cap:
+        found.cap = 2 * found.cap + 16
+        grown = <int64_t*> realloc(found.pair, 2 * found.cap * sizeof(int64_t))
+        if grown == NULL:
+            return -1
+        found.pair = grown
+    found.pair[2 * found.n] = i
+    found.pair[2 * found.n + 1] = j
+    found.n += 1
+    return 1
+
+
+cdef inline bint _runs_along(const double* p, const double* a, const double* b) noexcept nogil:
+    # the edges p -> a and p -> b leave p in one direction (they overlap)
+    if orient2d(p, a, b) != 0:
+        return False
+    if p[0] != a[0]:
+        return (a[0] < p[0]) == (b[0] < p[0])
+    return (a[1] < p[1]) == (b[1] < p[1])
+
+
 cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
-                      Py_ssize_t m) noexcept nogil:
+                      const int64_t* seg_ring, Py_ssize_t m, Touches* found) noexcept nogil:
     """1 when no two segments meet but consecutive ones of a ring at their shared end
-    (which _rings_fold_free judges), 0 when two do or the sweep gives up past
-    PROOF_TESTS_PER_SEGMENT tests per segment, -1 when out of memory.  The sweep goes
-    along the box's longer side slab by slab (m slabs, segments in the slab their
-    range begins in, a counting sort); a segment leaves the active ones once the
-    slab its range ends in is behind."""
-    cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis, slab
-    cdef int64_t tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
+    (which _rings_fold_free judges) and two rings' edges at a common vertex (_touch:
+    found gets them), 0 when two meet otherwise or the search gives up past
+    PROOF_TESTS_PER_SEGMENT pair tests per segment, -1 when out of memory.  Two
+    segments that meet share a cell of nearby.pxi's grid (their common point is in
+    both boxes, and a box is registered in every cell it overlaps), so each cell's
+    pairs are tested."""
+    cdef _Grid G
+    cdef Py_ssize_t c, i, j
+    cdef int64_t k, q, tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
     cdef int res = 1
-    cdef double box[4]
-    cdef double scale
-    cdef double* bb = <double*> malloc(4 * m * sizeof(double))
-    cdef Py_ssize_t* work = <Py_ssize_t*> malloc((5 * m + 1) * sizeof(Py_ssize_t))
-    cdef Py_ssize_t* first
-    cdef Py_ssize_t* order
-    cdef Py_ssize_t* begins
-    cdef Py_ssize_t* ends
-    cdef Py_ssize_t* active
-    if bb == NULL or work == NULL:
-        free(bb)
-        free(work)
-        return -1
-    first = work                # m + 1 slab starts into order
-    order = &work[m + 1]
-    ends = &work[2 * m + 1]     # the slab each segment's range ends in
-    active = &work[3 * m + 1]
-    begins = &work[4 * m + 1]   # the slab it begins in
-    box_of(xy, n, box)
-    axis = 0 if box[2] - box[0] >= box[3] - box[1] else 1
-    scale = m / (box[2 + axis] - box[axis]) if box[2 + axis] > box[axis] else 0.0
-    for k in range(m):          # bb[4k..4k+3]: low and high along the axis, across it
-        for j in range(2):
-            bb[4 * k + 2 * j] = min(xy[2 * seg[2 * k] + (axis ^ j)],
-                                    xy[2 * seg[2 * k + 1] + (axis ^ j)])
-            bb[4 * k + 2 * j + 1] = max(xy[2 * seg[2 * k] + (axis ^ j)],
-                                        xy[2 * seg[2 * k + 1] + (axis ^ j)])
-    for i in range(m + 1):
-        first[i] = 0
-    for k in range(m):
-        begins[k] = _slab(bb[4 * k], box[axis], scale, m - 1)
-        ends[k] = _slab(bb[4 * k + 1], box[axis], scale, m - 1)
-        first[begins[k] + 1] += 1
-    for i in range(m):
-        first[i + 1] += first[i]
-    for k in range(m):
-        order[first[begins[k]]] = k
-        first[begins[k]] += 1
-    slab = 0
-    for i in range(m):
-        k = order[i]
-        while first[slab] <= i:     # after the placing pass, first[s] is slab s's end
-            slab += 1
-        j = 0
-        for t in range(n_active):
-            q = active[t]
-            if ends[q] < slab:
-                continue            # ends before every segment still to come begins
-            active[j] = q
-            j += 1
-            tests += 1
-            if (bb[4 * q + 3] < bb[4 * k + 2] or bb[4 * k + 3] < bb[4 * q + 2]
-                    or bb[4 * q + 1] < bb[4 * k] or bb[4 * k + 1] < bb[4 * q]):
-                continue            # apart across the axis, or along it in one slab
-            if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
-                    or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
-                continue            # consecutive: a shared vertex index
-            if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
-                              &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
-                res = 0
+    G.start = NULL
+    G.item = NULL
+    if _grid_build(xy, n, seg, m, 0.0, &G) != 0:
+        res = -1
+    c = 0
+    while res == 1 and c < G.g * G.g:
+        for i in range(G.start[c], G.start[c + 1]):
+            k = G.item[i]
+            for j in range(i + 1, G.start[c + 1]):
+                q = G.item[j]
+                tests += 1
+                if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
+                        or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
+                    continue        # consecutive: a shared vertex index
+                if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                                  &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
+                    res = _touch(xy, seg, seg_ring, k, q, found)
+                    if res != 1:
+                        break
+            if res != 1 or tests > cap:
                 break
-        if res == 0 or tests > cap:
+        if tests > cap:
             res = 0
-            break
-        n_active = j
-        active[n_active] = k
-        n_active += 1
-    free(bb)
-    free(work)
+        c += 1
+    free(G.start)
+    free(G.item)
     return res
 
 
@@ -219,49 +218,313 @@ cdef bint _rings_fold_free(const double* xy, const int64_t* seg, const Py_ssize_
     return True
 
 
-cdef int _inside_any_hole(const double* xy, const int64_t* seg, const Py_ssize_t* start,
-                          Py_ssize_t h0, Py_ssize_t h1, Py_ssize_t skip,
-                          const double* p) noexcept nogil:
-    # p inside one of the rings h0..h1 - 1 but `skip`: 1, 0, or -1 (on an edge)
-    cdef Py_ssize_t q
-    cdef int inside
-    for q in range(h0, h1):
-        if q != skip:
-            inside = _inside_ring(xy, seg, start[q], start[q + 1], p)
-            if inside != 0:
-                return inside
-    return 0
+cdef int _in_angle(const double* p, const double* a1, const double* a0,
+                   const double* c) noexcept nogil:
+    """Whether c lies inside the angle swept counter-clockwise from the ray p -> a1 to
+    the ray p -> a0 (a ring's two edges at p, not folding back): 1 inside, 0 outside,
+    -1 on one of the rays (then an edge p -> c runs along that edge)."""
+    cdef int turn = orient2d(p, a1, a0), o1 = orient2d(p, a1, c), o0 = orient2d(p, a0, c)
+    if (o1 == 0 and not _opposite(p, a1, c)) or (o0 == 0 and not _opposite(p, a0, c)):
+        return -1
+    if turn > 0:
+        return o1 > 0 and o0 < 0
+    if turn < 0:
+        return o1 > 0 or o0 < 0
+    return o1 > 0               # a straight angle: the half-plane left of p -> a1
 
 
-cdef bint _rings_placed(const double* xy, const int64_t* seg, const Py_ssize_t* start,
-                        const int64_t* first_ring, Py_ssize_t n_polys) noexcept nogil:
-    """Polygon k owns rings first_ring[k] (its exterior) to first_ring[k + 1] - 1 (its
-    holes).  Every hole inside its exterior and outside its polygon's other holes, and
-    every exterior inside another polygon's exterior only within one of its holes
-    (the interiors then do not overlap), each judged at the ring's first vertex (the
-    rings meet nowhere, so a ring is wholly inside or outside another)."""
-    cdef Py_ssize_t k, j, r, shell
-    cdef const double* p
-    cdef int inside
-    for k in range(n_polys):
-        shell = first_ring[k]
-        for r in range(shell + 1, first_ring[k + 1]):
-            p = &xy[2 * seg[2 * start[r]]]
-            if _inside_ring(xy, seg, start[shell], start[shell + 1], p) != 1:
-                return False
-            if _inside_any_hole(xy, seg, start, shell + 1, first_ring[k + 1], r, p) != 0:
-                return False
-        p = &xy[2 * seg[2 * start[shell]]]
-        for j in range(n_polys):
-            if j == k:
-                continue
-            inside = _inside_ring(xy, seg, start[first_ring[j]], start[first_ring[j] + 1], p)
-            if inside == 0:
-                continue
-            if inside < 0 or _inside_any_hole(xy, seg, start, first_ring[j] + 1,
-                                              first_ring[j + 1], -1, p) != 1:
+cdef inline bint _opposite(const double* p, const double* a, const double* c) noexcept nogil:
+    # c, on the line pa, lies on the other side of p than a
+    return not _runs_along(p, a, c)
+
+
+cdef bint _touches_cross_free(const double* xy, const Touches* found, const int64_t* nextv,
+                              const int64_t* prevv) noexcept nogil:
+    """At every touch (i of one ring, j of another), each ring's two edges leave into
+    one of the two angles the other's edges make."""
+    cdef Py_ssize_t t, side
+    cdef int64_t u, w
+    cdef int s1, s0
+    for t in range(found.n):
+        for side in range(2):
+            u = found.pair[2 * t + side]
+            w = found.pair[2 * t + 1 - side]
+            s1 = _in_angle(&xy[2 * u], &xy[2 * nextv[u]], &xy[2 * prevv[u]], &xy[2 * nextv[w]])
+            s0 = _in_angle(&xy[2 * u], &xy[2 * nextv[u]], &xy[2 * prevv[u]], &xy[2 * prevv[w]])
+            if s1 < 0 or s0 < 0 or s1 != s0:
                 return False
     return True
+
+
+cdef int64_t _root(int64_t* parent, int64_t i) noexcept nogil:
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+cdef int _touches_acyclic(const Touches* found, const int64_t* vring,
+                          const int64_t* ring_poly, Py_ssize_t n,
+                          Py_ssize_t n_rings) noexcept nogil:
+    """1 when the touches between rings of one polygon form no cycle: the graph of
+    rings and touch points (a point joined to each ring through it) is a forest.  The
+    vertices at one point are grouped (through the pairs), then each polygon's rings
+    at that point are joined to the first of them: joining two rings already joined
+    closes a cycle.  0 when they do, -1 when out of memory."""
+    cdef Py_ssize_t t, k, a, b, s0, n_touched = 0
+    cdef int64_t v, ra, rb
+    cdef int res = 1
+    cdef int64_t* vparent = <int64_t*> malloc(n * sizeof(int64_t))
+    cdef int64_t* rparent = <int64_t*> malloc(n_rings * sizeof(int64_t))
+    cdef int64_t* key = <int64_t*> malloc(2 * found.n * sizeof(int64_t))
+    if vparent == NULL or rparent == NULL or key == NULL:
+        res = -1
+    else:
+        for k in range(n):
+            vparent[k] = k
+        for k in range(n_rings):
+            rparent[k] = k
+        for t in range(found.n):
+            ra = _root(vparent, found.pair[2 * t])
+            rb = _root(vparent, found.pair[2 * t + 1])
+            if ra != rb:
+                vparent[rb] = ra
+        # the touched vertices by group (its root), each once
+        for t in range(2 * found.n):
+            v = found.pair[t]
+            key[t] = _root(vparent, v) * n + v
+        qsort(key, 2 * found.n, sizeof(int64_t), int64_order)
+        for t in range(2 * found.n):
+            if t == 0 or key[t] != key[t - 1]:
+                key[n_touched] = key[t]
+                n_touched += 1
+        s0 = 0
+        for a in range(n_touched):
+            if key[a] // n != key[s0] // n:
+                s0 = a              # a new group starts
+            for b in range(s0, a):
+                if ring_poly[vring[key[b] % n]] == ring_poly[vring[key[a] % n]]:
+                    ra = _root(rparent, vring[key[b] % n])
+                    rb = _root(rparent, vring[key[a] % n])
+                    if ra == rb:
+                        res = 0
+                    rparent[rb] = ra
+                    break
+            if res == 0:
+                break
+    free(vparent)
+    free(rparent)
+    free(key)
+    return res
+
+
+cdef struct Bands:
+    # The segments by horizontal band of the points' box (m bands): band b's are
+    # seg_of[first[b] .. first[b + 1]), every segment whose y range meets the band.
+    Py_ssize_t* first
+    Py_ssize_t* seg_of
+    double base, scale
+    Py_ssize_t last
+
+
+cdef int _bands(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
+                int64_t cap, Bands* B) noexcept nogil:
+    """Fill B; 1, 0 when the segments would fill more than cap entries (long edges
+    across many bands), -1 when out of memory."""
+    cdef Py_ssize_t k, b, lo, hi
+    cdef int64_t total = 0
+    cdef double box[4]
+    box_of(xy, n, box)
+    B.base = box[1]
+    B.scale = m / (box[3] - box[1]) if box[3] > box[1] else 0.0
+    B.last = m - 1
+    B.seg_of = NULL
+    B.first = <Py_ssize_t*> malloc((m + 1) * sizeof(Py_ssize_t))
+    if B.first == NULL:
+        return -1
+    for b in range(m + 1):
+        B.first[b] = 0
+    for k in range(m):
+        lo = _slab(min(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
+        hi = _slab(max(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
+        total += hi - lo + 1
+        for b in range(lo, hi + 1):
+            B.first[b + 1] += 1
+        if total > cap:
+            return 0
+    for b in range(m):
+        B.first[b + 1] += B.first[b]
+    B.seg_of = <Py_ssize_t*> malloc((total if total > 0 else 1) * sizeof(Py_ssize_t))
+    if B.seg_of == NULL:
+        return -1
+    for k in range(m):
+        lo = _slab(min(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
+        hi = _slab(max(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
+        for b in range(lo, hi + 1):
+            B.seg_of[B.first[b]] = k
+            B.first[b] += 1
+    for b in range(m, 0, -1):       # the filling moved each start to the next band's
+        B.first[b] = B.first[b - 1]
+    B.first[0] = 0
+    return 1
+
+
+cdef enum:
+    RING_ODD = 1        # _ray_parities: an odd number of crossings
+    RING_LISTED = 2     # crossed at all (in odd_rings once)
+
+
+cdef int _ray_parities(const double* xy, const int64_t* seg, const int64_t* seg_ring,
+                       const Bands* B, int64_t r, const double* p, uint8_t* odd,
+                       int64_t* odd_rings, Py_ssize_t* n_odd,
+                       int64_t* tests) noexcept nogil:
+    """odd[q] & RING_ODD = the parity of the crossings of the ray from p towards +x
+    with ring q's segments, for every ring but r (p's own); the rings crossed at all
+    into odd_rings (n_odd of them, marked RING_LISTED).  An edge counts when one end
+    lies above p's y and the other not, and p lies left of it taken upwards.  1, or 0
+    when p lies on an edge (nothing is proved)."""
+    cdef Py_ssize_t b = _slab(p[1], B.base, B.scale, B.last), t, k
+    cdef const double* a
+    cdef const double* c
+    cdef int o
+    n_odd[0] = 0
+    tests[0] += B.first[b + 1] - B.first[b]
+    for t in range(B.first[b], B.first[b + 1]):
+        k = B.seg_of[t]
+        if seg_ring[k] == r:
+            continue
+        a = &xy[2 * seg[2 * k]]
+        c = &xy[2 * seg[2 * k + 1]]
+        if (a[1] > p[1]) != (c[1] > p[1]):
+            o = orient2d(a, c, p)
+            if o == 0:
+                return 0
+            if (o > 0) == (c[1] > a[1]):
+                if not odd[seg_ring[k]] & RING_LISTED:
+                    odd_rings[n_odd[0]] = seg_ring[k]
+                    n_odd[0] += 1
+                odd[seg_ring[k]] ^= RING_ODD
+                odd[seg_ring[k]] |= RING_LISTED
+    return 1
+
+
+cdef bint _ring_in_place(int64_t r, const int64_t* ring_poly, const int64_t* first_ring,
+                         const uint8_t* odd, const int64_t* odd_rings, Py_ssize_t n_odd,
+                         uint8_t* in_shell, uint8_t* in_hole) noexcept nogil:
+    """From the parities at ring r's vertex: a hole inside its exterior and outside its
+    polygon's other holes; an exterior inside another polygon's exterior only within
+    one of its holes.  in_shell and in_hole (one per polygon, zero) are left zero."""
+    cdef Py_ssize_t t
+    cdef int64_t q, k = ring_poly[r], j
+    cdef bint ok = True
+    if r != first_ring[k]:
+        if not odd[first_ring[k]] & RING_ODD:
+            return False
+        for t in range(n_odd):
+            q = odd_rings[t]
+            if odd[q] & RING_ODD and ring_poly[q] == k and q != first_ring[k]:
+                return False
+        return True
+    for t in range(n_odd):
+        q = odd_rings[t]
+        if odd[q] & RING_ODD:
+            j = ring_poly[q]
+            if q == first_ring[j]:
+                in_shell[j] = 1
+            else:
+                in_hole[j] = 1
+    for t in range(n_odd):
+        j = ring_poly[odd_rings[t]]
+        if in_shell[j] and not in_hole[j]:
+            ok = False
+    for t in range(n_odd):
+        j = ring_poly[odd_rings[t]]
+        in_shell[j] = in_hole[j] = 0
+    return ok
+
+
+cdef int _rings_placed(const double* xy, Py_ssize_t n, const int64_t* seg,
+                       const int64_t* seg_ring, Py_ssize_t m, const int64_t* rep,
+                       const int64_t* ring_poly, const int64_t* first_ring,
+                       Py_ssize_t n_rings, Py_ssize_t n_polys) noexcept nogil:
+    """Every ring in its place (_ring_in_place), judged at its vertex rep[r], which
+    lies on no other ring.  1, 0 when not (or past PLACEMENT_TESTS_PER_SEGMENT work
+    per segment), -1 when out of memory."""
+    cdef Bands B
+    cdef int64_t cap = PLACEMENT_TESTS_PER_SEGMENT * m, tests = 0
+    cdef Py_ssize_t r, t, n_odd
+    cdef int res
+    cdef uint8_t* odd = <uint8_t*> calloc(n_rings + 2 * n_polys, 1)
+    cdef int64_t* odd_rings = <int64_t*> malloc(n_rings * sizeof(int64_t))
+    if odd == NULL or odd_rings == NULL:
+        free(odd)
+        free(odd_rings)
+        return -1
+    res = _bands(xy, n, seg, m, cap, &B)
+    r = 0
+    while res == 1 and r < n_rings:
+        res = _ray_parities(xy, seg, seg_ring, &B, r, &xy[2 * rep[r]], odd, odd_rings,
+                            &n_odd, &tests)
+        if res == 1 and (tests > cap or not _ring_in_place(
+                r, ring_poly, first_ring, odd, odd_rings, n_odd, &odd[n_rings],
+                &odd[n_rings + n_polys])):
+            res = 0
+        for t in range(n_odd):
+            odd[odd_rings[t]] = 0
+        r += 1
+    free(B.first)
+    free(B.seg_of)
+    free(odd)
+    free(odd_rings)
+    return res
+
+
+cdef int _representatives(const int64_t* seg, const Py_ssize_t* start, Py_ssize_t n_rings,
+                          const Touches* found, Py_ssize_t n, int64_t* rep) noexcept nogil:
+    """rep[r] = ring r's first vertex that touches no other ring; 1, 0 when a ring
+    has none, -1 when out of memory."""
+    cdef Py_ssize_t t, r, k
+    cdef uint8_t* touched = <uint8_t*> calloc(n if n > 0 else 1, 1)
+    if touched == NULL:
+        return -1
+    for t in range(2 * found.n):
+        touched[found.pair[t]] = 1
+    for r in range(n_rings):
+        rep[r] = -1
+        for k in range(start[r], start[r + 1]):
+            if not touched[seg[2 * k]]:
+                rep[r] = seg[2 * k]
+                break
+        if rep[r] < 0:
+            free(touched)
+            return 0
+    free(touched)
+    return 1
+
+
+cdef int _touches_valid(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
+                        const int64_t* seg_ring, const int64_t* ring_poly,
+                        Py_ssize_t n_rings, const Touches* found) noexcept nogil:
+    """The touches _no_contacts found cross nothing and close no cycle; 1, 0, or -1
+    when out of memory."""
+    cdef Py_ssize_t k
+    cdef int res
+    cdef int64_t* nextv = <int64_t*> malloc(3 * n * sizeof(int64_t))
+    cdef int64_t* prevv
+    cdef int64_t* vring
+    if nextv == NULL:
+        return -1
+    prevv = &nextv[n]
+    vring = &nextv[2 * n]
+    for k in range(m):
+        nextv[seg[2 * k]] = seg[2 * k + 1]
+        prevv[seg[2 * k + 1]] = seg[2 * k]
+        vring[seg[2 * k]] = seg_ring[k]
+    res = 1 if _touches_cross_free(xy, found, nextv, prevv) else 0
+    if res == 1:
+        res = _touches_acyclic(found, vring, ring_poly, n, n_rings)
+    free(nextv)
+    return res
 
 
 cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const int64_t* edge,
@@ -272,26 +535,46 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
     multipolygon, whose polygon k owns rings first_ring[k] (its exterior) to
     first_ring[k + 1] - 1 (see the top of this file); 0 when not proved, -1 when out
     of memory."""
-    cdef Py_ssize_t* start
-    cdef Py_ssize_t n_rings, k
+    cdef Py_ssize_t* start = NULL
+    cdef int64_t* per_ring = NULL      # rep (n_rings), ring_poly (n_rings), seg_ring (m)
+    cdef Py_ssize_t n_rings, k, r
     cdef int res
+    cdef Touches found
     if n_polys < 1 or m < 3 or first_ring[0] != 0:
         return 0
     for k in range(n_polys):
         if first_ring[k + 1] <= first_ring[k]:
             return 0
     n_rings = first_ring[n_polys]
-    if n_rings > 1 and (n_rings - 1) * m > RING_TESTS_MAX:
-        return 0
+    found.pair = NULL
+    found.n = found.cap = 0
     start = <Py_ssize_t*> malloc((n_rings + 1) * sizeof(Py_ssize_t))
-    if start == NULL:
+    per_ring = <int64_t*> malloc((2 * n_rings + m) * sizeof(int64_t))
+    if start == NULL or per_ring == NULL:
+        free(start)
+        free(per_ring)
         return -1
     res = _ring_starts(seg, edge, ring, m, n_rings, start)
-    if res == 1 and not _rings_fold_free(xy, seg, start, n_rings):
-        res = 0
     if res == 1:
-        res = _no_contacts(xy, n, seg, m)
-    if res == 1 and not _rings_placed(xy, seg, start, first_ring, n_polys):
-        res = 0
+        for k in range(n_polys):
+            for r in range(first_ring[k], first_ring[k + 1]):
+                per_ring[n_rings + r] = k
+        for r in range(n_rings):
+            for k in range(start[r], start[r + 1]):
+                per_ring[2 * n_rings + k] = r
+        if not _rings_fold_free(xy, seg, start, n_rings):
+            res = 0
+    if res == 1:
+        res = _no_contacts(xy, n, seg, &per_ring[2 * n_rings], m, &found)
+    if res == 1 and found.n:
+        res = _touches_valid(xy, n, seg, m, &per_ring[2 * n_rings], &per_ring[n_rings],
+                             n_rings, &found)
+    if res == 1:
+        res = _representatives(seg, start, n_rings, &found, n, per_ring)
+    if res == 1 and n_rings > 1:
+        res = _rings_placed(xy, n, seg, &per_ring[2 * n_rings], m, per_ring,
+                            &per_ring[n_rings], first_ring, n_rings, n_polys)
     free(start)
+    free(per_ring)
+    free(found.pair)
     return res

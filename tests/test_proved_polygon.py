@@ -79,6 +79,57 @@ def test_what_the_kernel_proves_a_valid_multipolygon_geos_finds_valid(polygons, 
     check_against_geos(MultiPolygon(moved))
 
 
+# Triangles and quadrilaterals with corners on a small grid, as holes of a square or as
+# parts beside it: they touch the square and each other at shared corners often, and
+# at edges, cross or nest as often.
+grid_ring = st.lists(st.tuples(grid, grid), min_size=3, max_size=4)
+
+
+@given(st.lists(grid_ring, min_size=1, max_size=4), st.lists(grid_ring, max_size=3))
+def test_rings_touching_at_corners_are_proved_only_where_geos_finds_them_valid(holes, parts):
+    square = Polygon([(0, 0), (4, 0), (4, 4), (0, 4)], holes)
+    check_against_geos(square)
+    if parts:
+        check_against_geos(MultiPolygon([square] + [Polygon(p) for p in parts]))
+
+
+def diamonds(rows: int, per_row: int, row_gap: float) -> list[list[tuple[float, float]]]:
+    """Rows of diamonds (squares turned by 45 degrees, half-diagonal 1), each touching
+    the next in its row at a corner; rows row_gap apart."""
+    out = []
+    for j in range(rows):
+        y = 1.0 + row_gap * j
+        for i in range(per_row):
+            x = 1.0 + 2.0 * i
+            out.append([(x - 1, y), (x, y - 1), (x + 1, y), (x, y + 1)])
+    return out
+
+
+def test_chains_of_touching_holes_are_proved_and_meshed_as_without_the_proof(checked, monkeypatch):
+    # 8 rows of 8 holes, each row a chain touching the exterior at its left end: the
+    # touches form no cycle, so the interior is connected
+    holes = diamonds(8, 8, 3.0)
+    left_side = [(0.0, 1.0 + 3.0 * j) for j in range(7, -1, -1)]  # the rows' left corners
+    poly = Polygon([(0, -1), (17, -1), (17, 24), (0, 24)] + left_side, holes)
+    assert check_against_geos(poly)
+    mesh = checked(aftmesh.generate(poly, 0.7))
+    with monkeypatch.context() as m:
+        m.setattr(inputs, "proved_polygon", lambda p: None)
+        plain = aftmesh.generate(poly, 0.7)
+    assert np.array_equal(mesh.points, plain.points)
+    assert np.array_equal(mesh.triangles, plain.triangles)
+
+
+def test_holes_touching_in_a_cycle_are_left_to_geos():
+    # two rows of diamonds touching each other too: every four enclose a piece of the
+    # interior, which is then not connected
+    poly = Polygon([(-1, -1), (9, -1), (9, 9), (-1, 9)], diamonds(2, 4, 2.0))
+    assert not poly.is_valid
+    assert inputs.proved_polygon(poly) is None
+    with pytest.raises(InvalidDomainError, match="not a valid polygon"):
+        aftmesh.generate(poly, 0.5)
+
+
 # A unit square, and a hole whose corners sit a few ulps from its edges or from each
 # other: near-degenerate cases the proof must decide exactly.
 ulps = st.integers(-3, 3)
@@ -109,14 +160,49 @@ PINNED = {
     ),
     "hole touching the exterior at a corner": (
         Polygon(SQUARE, [[(0, 0), (1, 2), (2, 1)]]),
-        False,
+        True,
         True,
     ),
     "hole touching an exterior edge": (Polygon(SQUARE, [[(2, 0), (3, 1), (1, 1)]]), False, True),
     "holes touching at a point": (
         Polygon(SQUARE, [[(1, 1), (2, 2), (1, 2)], [(2, 2), (3, 3), (3, 2)]]),
-        False,
         True,
+        True,
+    ),
+    "two holes touching the exterior at one corner": (
+        Polygon(SQUARE, [[(0, 0), (2, 0.5), (2, 1.5)], [(0, 0), (1.5, 2), (0.5, 2)]]),
+        True,
+        True,
+    ),
+    "hole touching the exterior twice": (
+        Polygon(SQUARE, [[(0, 0), (2, 1), (4, 4), (1, 2)]]),
+        False,
+        False,
+    ),
+    "holes and the exterior touching in a cycle": (
+        Polygon(SQUARE, [[(0, 0), (2, 1), (2, 2)], [(2, 2), (1, 2.5), (0, 4)]]),
+        False,
+        False,
+    ),
+    "holes sharing an edge from a corner": (
+        Polygon(SQUARE, [[(0, 0), (2, 1), (2, 2), (1, 2)], [(0, 0), (1, 2), (0.5, 2.5)]]),
+        False,
+        False,
+    ),
+    "hole through the exterior at a corner": (
+        Polygon(SQUARE, [[(0, 0), (-1, 1), (1, 1)]]),
+        False,
+        False,
+    ),
+    "hole inside a hole it touches": (
+        Polygon(SQUARE, [[(1, 1), (3, 1), (3, 3), (1, 3)], [(3, 3), (2, 2.5), (2.5, 2)]]),
+        False,
+        False,
+    ),
+    "hole along an exterior edge from a corner": (
+        Polygon(SQUARE, [[(0, 0), (2, 0), (1, 1)]]),
+        False,
+        False,
     ),
     "hole outside": (Polygon(SQUARE, [[(5, 5), (6, 5), (6, 6)]]), False, False),
     "nested holes": (
@@ -141,7 +227,27 @@ PINNED = {
         True,
     ),
     "one part of a multipolygon": (MultiPolygon([Polygon(SQUARE)]), True, True),
-    "parts touching at a corner": (MultiPolygon([box(0, 0, 1, 1), box(1, 1, 2, 2)]), False, True),
+    "parts touching at a corner": (MultiPolygon([box(0, 0, 1, 1), box(1, 1, 2, 2)]), True, True),
+    "parts touching at two points": (
+        MultiPolygon(
+            [
+                Polygon([(0, 0), (2, 0), (1.5, 1), (2, 2), (0, 2)]),
+                Polygon([(2, 0), (3, 1), (2, 2), (2.5, 1)]),
+            ]
+        ),
+        True,
+        True,
+    ),
+    "part in a hole it touches": (
+        MultiPolygon(
+            [
+                Polygon(SQUARE, [[(1, 1), (3, 1), (3, 3), (1, 3)]]),
+                Polygon([(1, 1), (2.5, 1.5), (1.5, 2.5)]),
+            ]
+        ),
+        True,
+        True,
+    ),
     "parts sharing an edge": (MultiPolygon([box(0, 0, 1, 1), box(1, 0, 2, 1)]), False, False),
     "one part inside the other": (MultiPolygon([box(0, 0, 4, 4), box(1, 1, 2, 2)]), False, False),
     "overlapping parts": (MultiPolygon([box(0, 0, 2, 2), box(1, 1, 3, 3)]), False, False),
@@ -149,7 +255,7 @@ PINNED = {
 
 
 @pytest.mark.parametrize("name", list(PINNED))
-def test_pinned_polygons_are_proved_only_when_valid_and_apart(name):
+def test_pinned_polygons_are_proved_only_when_valid_and_touching_at_most_at_vertices(name):
     poly, proved, valid = PINNED[name]
     assert poly.is_valid == valid
     assert check_against_geos(poly) == proved

@@ -185,7 +185,8 @@ def _noded(
     ring_polygon: np.ndarray | None = None,
 ) -> Domain:
     """_from_shapely's Domain from the rings' arrays (_ring_arrays); `apart`: the
-    rings are known to meet nowhere (see merge_and_node), ring_polygon: then the
+    rings are known to meet nowhere but at common vertices (see merge_and_node),
+    ring_polygon: then the
     polygon of each ring, for the Domain."""
     n_rings = len(rings[5])
     verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
@@ -217,9 +218,10 @@ def _noded(
 
 def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
     """from_geometry(domain) for a lone Polygon or MultiPolygon whose rings the kernel
-    proves valid (rings_proved_valid: simple, meeting nowhere, holes in place, parts
-    apart), without GEOS's validity check, which costs more than the rest of the
-    conversion on a small polygon; None when anything is not plainly fine (empty, z
+    proves valid (rings_proved_valid: simple, meeting at most at common vertices where
+    none crosses another and a polygon's own touches close no cycle, holes in place,
+    parts apart or touching so), without GEOS's validity check, which costs more than
+    the rest of the conversion on a small polygon; None when anything is not plainly fine (empty, z
     values, a coordinate not finite or out of range, rings not proved), and
     from_geometry then decides, with its messages.  The Domain is the one
     from_geometry makes."""

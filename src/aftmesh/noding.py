@@ -103,8 +103,9 @@ def merge_and_node(
     snapped), so the split is skipped, and so is the search for repeated segments;
     with several small rings, a pairwise look in the kernel says whether any of that
     is needed at all (rings touching at a point are rare).  `apart` says more: the
-    valid rings meet nowhere (the kernel proved it, inputs.proved_polygon), so none of
-    it is needed, however many rings there are."""
+    valid rings meet nowhere but at common vertices, which the merge joins (the kernel
+    proved it, inputs.proved_polygon), so nothing else is needed, however many rings
+    there are."""
     n_merged = 0
     if tolerance > 0:
         verts, n_merged = merge_close(verts, tolerance)
@@ -114,9 +115,9 @@ def merge_and_node(
     segs = inverse[segs]
     exact_valid = valid_rings and not tolerance > 0
     if exact_valid and (valid_rings == 1 or apart):
-        # one simple ring of at least three distinct vertices, or rings apart: no
-        # vertex on another segment, no segment given twice or from a vertex to
-        # itself, no crossing
+        # one simple ring of at least three distinct vertices, or rings apart but for
+        # common vertices (now merged): no vertex on another segment, no segment
+        # given twice or from a vertex to itself, no crossing
         return uniq, segs, src
     if exact_valid and len(uniq) * len(segs) <= PROPER_CHECK_PAIRS and rings_proper(uniq, segs):
         # the rings of a valid polygon that touch nowhere (the usual polygon with
