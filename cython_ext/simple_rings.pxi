@@ -126,7 +126,7 @@ cdef int _touch(const double* xy, const int64_t* seg, const int64_t* seg_ring,
     """Segments k and q, known to meet: 1 when they are of different rings and meet
     only at an end of both, a point (found gets the two vertices there), 0 when they
     meet otherwise, -1 when out of memory."""
-    cdef int64_t i = -1, j = -1, a, b, c, d
+    cdef int64_t i = -1, j = -1, a = -1, b = -1
     cdef int shared = 0, ai, bj
     cdef int64_t* grown
     if seg_ring[k] == seg_ring[q]:
