@@ -31,6 +31,10 @@ from libc.stdlib cimport malloc, realloc, free, qsort
 # a few segments of the rings people draw, but many segments through one cell (a fan
 # of edges from one vertex) would make the search quadratic.
 cdef int64_t PROOF_TESTS_PER_SEGMENT = 32
+# Rings up to which the contacts are searched by a sweep (a line across the rings
+# stabs a few segments of each), beyond by a grid (whose cells hold a few segments
+# however many rings there are, but which costs more to build).
+cdef Py_ssize_t SWEEP_MAX_RINGS = 16
 # The placement's work allowed per segment (band entries, and the segments tested
 # against the rays of the rings' vertices) before leaving the proof to GEOS: a few
 # per segment on the rings people draw, but a thousand holes stacked along one
@@ -165,14 +169,106 @@ cdef inline bint _runs_along(const double* p, const double* a, const double* b) 
 
 
 cdef int _no_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
-                      const int64_t* seg_ring, Py_ssize_t m, Touches* found) noexcept nogil:
+                      const int64_t* seg_ring, Py_ssize_t n_rings, Py_ssize_t m,
+                      Touches* found) noexcept nogil:
     """1 when no two segments meet but consecutive ones of a ring at their shared end
     (which _rings_fold_free judges) and two rings' edges at a common vertex (_touch:
     found gets them), 0 when two meet otherwise or the search gives up past
-    PROOF_TESTS_PER_SEGMENT pair tests per segment, -1 when out of memory.  Two
-    segments that meet share a cell of nearby.pxi's grid (their common point is in
-    both boxes, and a box is registered in every cell it overlaps), so each cell's
-    pairs are tested."""
+    PROOF_TESTS_PER_SEGMENT pair tests per segment, -1 when out of memory.  A line
+    across a few rings stabs a few of their segments, so a sweep tests each segment
+    against a few; across many rings it stabs many, and a grid's cells hold fewer."""
+    if n_rings <= SWEEP_MAX_RINGS:
+        return _swept_contacts(xy, n, seg, seg_ring, m, found)
+    return _gridded_contacts(xy, n, seg, seg_ring, m, found)
+
+
+cdef int _swept_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
+                         const int64_t* seg_ring, Py_ssize_t m, Touches* found) noexcept nogil:
+    """_no_contacts by a sweep along the box's longer side, slab by slab (m slabs,
+    segments in the slab their range begins in, a counting sort): a segment is tested
+    against the active ones, and leaves them once the slab its range ends in is
+    behind."""
+    cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis, slab
+    cdef int64_t tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
+    cdef int res = 1
+    cdef double box[4]
+    cdef double scale
+    cdef double* bb = <double*> malloc(4 * m * sizeof(double))
+    cdef Py_ssize_t* work = <Py_ssize_t*> malloc((5 * m + 1) * sizeof(Py_ssize_t))
+    cdef Py_ssize_t* first
+    cdef Py_ssize_t* order
+    cdef Py_ssize_t* begins
+    cdef Py_ssize_t* ends
+    cdef Py_ssize_t* active
+    if bb == NULL or work == NULL:
+        free(bb)
+        free(work)
+        return -1
+    first = work                # m + 1 slab starts into order
+    order = &work[m + 1]
+    ends = &work[2 * m + 1]     # the slab each segment's range ends in
+    active = &work[3 * m + 1]
+    begins = &work[4 * m + 1]   # the slab it begins in
+    box_of(xy, n, box)
+    axis = 0 if box[2] - box[0] >= box[3] - box[1] else 1
+    scale = m / (box[2 + axis] - box[axis]) if box[2 + axis] > box[axis] else 0.0
+    for k in range(m):          # bb[4k..4k+3]: low and high along the axis, across it
+        for j in range(2):
+            bb[4 * k + 2 * j] = min(xy[2 * seg[2 * k] + (axis ^ j)],
+                                    xy[2 * seg[2 * k + 1] + (axis ^ j)])
+            bb[4 * k + 2 * j + 1] = max(xy[2 * seg[2 * k] + (axis ^ j)],
+                                        xy[2 * seg[2 * k + 1] + (axis ^ j)])
+    for i in range(m + 1):
+        first[i] = 0
+    for k in range(m):
+        begins[k] = _slab(bb[4 * k], box[axis], scale, m - 1)
+        ends[k] = _slab(bb[4 * k + 1], box[axis], scale, m - 1)
+        first[begins[k] + 1] += 1
+    for i in range(m):
+        first[i + 1] += first[i]
+    for k in range(m):
+        order[first[begins[k]]] = k
+        first[begins[k]] += 1
+    slab = 0
+    for i in range(m):
+        k = order[i]
+        while first[slab] <= i:     # after the placing pass, first[s] is slab s's end
+            slab += 1
+        j = 0
+        for t in range(n_active):
+            q = active[t]
+            if ends[q] < slab:
+                continue            # ends before every segment still to come begins
+            active[j] = q
+            j += 1
+            tests += 1
+            if (bb[4 * q + 3] < bb[4 * k + 2] or bb[4 * k + 3] < bb[4 * q + 2]
+                    or bb[4 * q + 1] < bb[4 * k] or bb[4 * k + 1] < bb[4 * q]):
+                continue            # apart across the axis, or along it in one slab
+            if (seg[2 * k] == seg[2 * q + 1] or seg[2 * k + 1] == seg[2 * q]
+                    or seg[2 * k] == seg[2 * q] or seg[2 * k + 1] == seg[2 * q + 1]):
+                continue            # consecutive: a shared vertex index
+            if _segments_meet(&xy[2 * seg[2 * k]], &xy[2 * seg[2 * k + 1]],
+                              &xy[2 * seg[2 * q]], &xy[2 * seg[2 * q + 1]]):
+                res = _touch(xy, seg, seg_ring, k, q, found)
+                if res != 1:
+                    break
+        if res != 1 or tests > cap:
+            res = res if res < 0 else 0
+            break
+        n_active = j
+        active[n_active] = k
+        n_active += 1
+    free(bb)
+    free(work)
+    return res
+
+
+cdef int _gridded_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
+                           const int64_t* seg_ring, Py_ssize_t m, Touches* found) noexcept nogil:
+    """_no_contacts by nearby.pxi's grid: two segments that meet share a cell (their
+    common point is in both boxes, and a box is registered in every cell it
+    overlaps), so each cell's pairs are tested."""
     cdef _Grid G
     cdef Py_ssize_t c, i, j
     cdef int64_t k, q, tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
@@ -565,7 +661,7 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
         if not _rings_fold_free(xy, seg, start, n_rings):
             res = 0
     if res == 1:
-        res = _no_contacts(xy, n, seg, &per_ring[2 * n_rings], m, &found)
+        res = _no_contacts(xy, n, seg, &per_ring[2 * n_rings], n_rings, m, &found)
     if res == 1 and found.n:
         res = _touches_valid(xy, n, seg, m, &per_ring[2 * n_rings], &per_ring[n_rings],
                              n_rings, &found)
