@@ -11,9 +11,12 @@
 # use; what this cannot prove (a vertex on another ring's edge, a ring touching
 # itself, a search past its caps) is left to GEOS, which then also names what is wrong.
 #
-# Two closed segments that meet have a point in both of their boxes, so they share a
-# cell of a grid of about one cell a segment (nearby.pxi), and each cell's pairs are
-# tested by exact orient2d: a few a cell on the rings people draw.  At a touch, a ring
+# Two closed segments that meet overlap in x and in y, so a sweep along the longer side
+# of the points' box tests each segment, by exact orient2d, against the segments whose
+# range along it overlaps its own and whose box meets its box: the ones the sweep line
+# stabs, a few on a few rings.  Across many rings it stabs many, so there the segments
+# that meet are found as pairs sharing a cell of a grid of about one cell a segment
+# (nearby.pxi; their common point is in both boxes).  At a touch, a ring
 # does not cross another when both of its edges there leave into the same one of the
 # two angles the other's edges make (exact orient2d).  A ring's place is the crossing
 # number of a ray from one of its vertices that touches nothing, counted for every
@@ -27,19 +30,22 @@
 from libc.stdint cimport int64_t, uint8_t
 from libc.stdlib cimport malloc, realloc, free, qsort
 
-# Segment pairs tested per segment before leaving the proof to GEOS: a grid cell holds
-# a few segments of the rings people draw, but many segments through one cell (a fan
-# of edges from one vertex) would make the search quadratic.
+# Segment pairs tested per segment before leaving the proof to GEOS: the sweep line, or
+# a grid cell, meets a few segments of the rings people draw, but a comb of many
+# parallel teeth, or a fan of edges from one vertex, would make the search quadratic.
 cdef int64_t PROOF_TESTS_PER_SEGMENT = 32
 # Rings up to which the contacts are searched by a sweep (a line across the rings
 # stabs a few segments of each), beyond by a grid (whose cells hold a few segments
 # however many rings there are, but which costs more to build).
 cdef Py_ssize_t SWEEP_MAX_RINGS = 16
-# The placement's work allowed per segment (band entries, and the segments tested
-# against the rays of the rings' vertices) before leaving the proof to GEOS: a few
-# per segment on the rings people draw, but a thousand holes stacked along one
-# horizontal line would each test the others' segments.
+# The placement's work allowed per segment (the segments tested against the rays of
+# the rings' vertices) before leaving the proof to GEOS: a few per segment on the
+# rings people draw, but a thousand holes stacked along one horizontal line would
+# each test the others' segments.
 cdef int64_t PLACEMENT_TESTS_PER_SEGMENT = 64
+# Entries per segment allowed in the placement's bands before they are made coarser:
+# long edges across many bands (tall thin parts) would otherwise fill many each.
+cdef int64_t BAND_ENTRIES_PER_SEGMENT = 8
 
 
 cdef inline bint _on_span(const double* a, const double* b, const double* c) noexcept nogil:
@@ -415,59 +421,71 @@ cdef int _touches_acyclic(const Touches* found, const int64_t* vring,
 
 
 cdef struct Bands:
-    # The segments by horizontal band of the points' box (m bands): band b's are
+    # The segments by horizontal band of the points' box (nb bands): band b's are
     # seg_of[first[b] .. first[b + 1]), every segment whose y range meets the band.
     Py_ssize_t* first
     Py_ssize_t* seg_of
     double base, scale
-    Py_ssize_t last
+    Py_ssize_t nb, last
+
+
+cdef inline void _band_range(const double* xy, const int64_t* seg, Py_ssize_t k,
+                             const Bands* B, Py_ssize_t* lo, Py_ssize_t* hi) noexcept nogil:
+    cdef double y0 = xy[2 * seg[2 * k] + 1], y1 = xy[2 * seg[2 * k + 1] + 1]
+    lo[0] = _slab(min(y0, y1), B.base, B.scale, B.last)
+    hi[0] = _slab(max(y0, y1), B.base, B.scale, B.last)
 
 
 cdef int _bands(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
-                int64_t cap, Bands* B) noexcept nogil:
-    """Fill B; 1, 0 when the segments would fill more than cap entries (long edges
-    across many bands), -1 when out of memory."""
+                Bands* B) noexcept nogil:
+    """Fill B: as many bands as segments, halved while the segments would fill more
+    than BAND_ENTRIES_PER_SEGMENT entries each (long edges across many bands).  0, or
+    -1 when out of memory."""
     cdef Py_ssize_t k, b, lo, hi
-    cdef int64_t total = 0
+    cdef int64_t total
     cdef double box[4]
     box_of(xy, n, box)
     B.base = box[1]
-    B.scale = m / (box[3] - box[1]) if box[3] > box[1] else 0.0
-    B.last = m - 1
     B.seg_of = NULL
-    B.first = <Py_ssize_t*> malloc((m + 1) * sizeof(Py_ssize_t))
-    if B.first == NULL:
+    B.first = NULL
+    B.nb = m
+    while True:
+        B.scale = B.nb / (box[3] - box[1]) if box[3] > box[1] else 0.0
+        B.last = B.nb - 1
+        total = 0
+        for k in range(m):
+            _band_range(xy, seg, k, B, &lo, &hi)
+            total += hi - lo + 1
+        if total <= BAND_ENTRIES_PER_SEGMENT * m or B.nb == 1:
+            break
+        B.nb = (B.nb + 1) // 2
+    B.first = <Py_ssize_t*> malloc((B.nb + 1) * sizeof(Py_ssize_t))
+    B.seg_of = <Py_ssize_t*> malloc((total if total > 0 else 1) * sizeof(Py_ssize_t))
+    if B.first == NULL or B.seg_of == NULL:
         return -1
-    for b in range(m + 1):
+    for b in range(B.nb + 1):
         B.first[b] = 0
     for k in range(m):
-        lo = _slab(min(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
-        hi = _slab(max(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
-        total += hi - lo + 1
+        _band_range(xy, seg, k, B, &lo, &hi)
         for b in range(lo, hi + 1):
             B.first[b + 1] += 1
-        if total > cap:
-            return 0
-    for b in range(m):
+    for b in range(B.nb):
         B.first[b + 1] += B.first[b]
-    B.seg_of = <Py_ssize_t*> malloc((total if total > 0 else 1) * sizeof(Py_ssize_t))
-    if B.seg_of == NULL:
-        return -1
     for k in range(m):
-        lo = _slab(min(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
-        hi = _slab(max(xy[2 * seg[2 * k] + 1], xy[2 * seg[2 * k + 1] + 1]), B.base, B.scale, B.last)
+        _band_range(xy, seg, k, B, &lo, &hi)
         for b in range(lo, hi + 1):
             B.seg_of[B.first[b]] = k
             B.first[b] += 1
-    for b in range(m, 0, -1):       # the filling moved each start to the next band's
+    for b in range(B.nb, 0, -1):    # the filling moved each start to the next band's
         B.first[b] = B.first[b - 1]
     B.first[0] = 0
-    return 1
+    return 0
 
 
 cdef enum:
     RING_ODD = 1        # _ray_parities: an odd number of crossings
     RING_LISTED = 2     # crossed at all (in odd_rings once)
+    RING_THROUGH = 4    # through the ray's origin: placed by _touching_sides instead
 
 
 cdef int _ray_parities(const double* xy, const int64_t* seg, const int64_t* seg_ring,
@@ -475,7 +493,8 @@ cdef int _ray_parities(const double* xy, const int64_t* seg, const int64_t* seg_
                        int64_t* odd_rings, Py_ssize_t* n_odd,
                        int64_t* tests) noexcept nogil:
     """odd[q] & RING_ODD = the parity of the crossings of the ray from p towards +x
-    with ring q's segments, for every ring but r (p's own); the rings crossed at all
+    with ring q's segments, for every ring but r (p's own) and those marked
+    RING_THROUGH; the rings crossed at all
     into odd_rings (n_odd of them, marked RING_LISTED).  An edge counts when one end
     lies above p's y and the other not, and p lies left of it taken upwards.  1, or 0
     when p lies on an edge (nothing is proved)."""
@@ -487,7 +506,7 @@ cdef int _ray_parities(const double* xy, const int64_t* seg, const int64_t* seg_
     tests[0] += B.first[b + 1] - B.first[b]
     for t in range(B.first[b], B.first[b + 1]):
         k = B.seg_of[t]
-        if seg_ring[k] == r:
+        if seg_ring[k] == r or odd[seg_ring[k]] & RING_THROUGH:
             continue
         a = &xy[2 * seg[2 * k]]
         c = &xy[2 * seg[2 * k + 1]]
@@ -539,15 +558,58 @@ cdef bint _ring_in_place(int64_t r, const int64_t* ring_poly, const int64_t* fir
     return ok
 
 
+cdef struct RingLinks:
+    # Each vertex's neighbours along its ring and its ring, and each ring's
+    # orientation: what placing a ring at a touched vertex needs (NULL when no ring
+    # touches another).
+    int64_t* nextv
+    int64_t* prevv
+    int64_t* vring
+    uint8_t* ccw
+
+
+cdef void _touching_sides(const double* xy, const Touches* found, const RingLinks* L,
+                          int64_t v, uint8_t mark, uint8_t* odd, int64_t* odd_rings,
+                          Py_ssize_t* n_odd) noexcept nogil:
+    """For every ring through v (a vertex of ring r that touches others there): with
+    mark, mark it RING_THROUGH; without, set its parity at v to whether r lies inside
+    it, r's edges at v leaving into its inside (the angle from its next vertex to its
+    previous one counter-clockwise, for a counter-clockwise ring; the other angle for
+    a clockwise one): r crosses no ring, so this holds for all of r."""
+    cdef Py_ssize_t t, side
+    cdef int64_t w, q
+    cdef int inside
+    for t in range(found.n):
+        for side in range(2):
+            if found.pair[2 * t + side] != v:
+                continue
+            w = found.pair[2 * t + 1 - side]
+            q = L.vring[w]
+            if mark:
+                odd[q] |= mark
+                continue
+            inside = _in_angle(&xy[2 * v], &xy[2 * L.nextv[w]], &xy[2 * L.prevv[w]],
+                               &xy[2 * L.nextv[v]])
+            if not L.ccw[q]:
+                inside = not inside
+            if not odd[q] & RING_LISTED:
+                odd_rings[n_odd[0]] = q
+                n_odd[0] += 1
+            odd[q] = (odd[q] & ~RING_ODD) | RING_LISTED | (RING_ODD if inside else 0)
+
+
 cdef int _rings_placed(const double* xy, Py_ssize_t n, const int64_t* seg,
                        const int64_t* seg_ring, Py_ssize_t m, const int64_t* rep,
-                       const int64_t* ring_poly, const int64_t* first_ring,
-                       Py_ssize_t n_rings, Py_ssize_t n_polys) noexcept nogil:
+                       const RingLinks* L, const Touches* found, const int64_t* ring_poly,
+                       const int64_t* first_ring, Py_ssize_t n_rings,
+                       Py_ssize_t n_polys) noexcept nogil:
     """Every ring in its place (_ring_in_place), judged at its vertex rep[r], which
-    lies on no other ring.  1, 0 when not (or past PLACEMENT_TESTS_PER_SEGMENT work
-    per segment), -1 when out of memory."""
+    lies on no other ring, or, when every vertex of r touches another ring, at ~rep[r]
+    (the rings through it placed by _touching_sides, the others by the ray).  1, 0
+    when not (or past PLACEMENT_TESTS_PER_SEGMENT work per segment), -1 when out of
+    memory."""
     cdef Bands B
-    cdef int64_t cap = PLACEMENT_TESTS_PER_SEGMENT * m, tests = 0
+    cdef int64_t cap = PLACEMENT_TESTS_PER_SEGMENT * m, tests = 0, v
     cdef Py_ssize_t r, t, n_odd
     cdef int res
     cdef uint8_t* odd = <uint8_t*> calloc(n_rings + 2 * n_polys, 1)
@@ -556,16 +618,22 @@ cdef int _rings_placed(const double* xy, Py_ssize_t n, const int64_t* seg,
         free(odd)
         free(odd_rings)
         return -1
-    res = _bands(xy, n, seg, m, cap, &B)
+    res = 1 if _bands(xy, n, seg, m, &B) == 0 else -1
     r = 0
     while res == 1 and r < n_rings:
-        res = _ray_parities(xy, seg, seg_ring, &B, r, &xy[2 * rep[r]], odd, odd_rings,
+        v = rep[r] if rep[r] >= 0 else ~rep[r]
+        if rep[r] < 0:
+            _touching_sides(xy, found, L, v, RING_THROUGH, odd, odd_rings, &n_odd)
+            tests += 2 * found.n
+        res = _ray_parities(xy, seg, seg_ring, &B, r, &xy[2 * v], odd, odd_rings,
                             &n_odd, &tests)
+        if rep[r] < 0:
+            _touching_sides(xy, found, L, v, 0, odd, odd_rings, &n_odd)
         if res == 1 and (tests > cap or not _ring_in_place(
                 r, ring_poly, first_ring, odd, odd_rings, n_odd, &odd[n_rings],
                 &odd[n_rings + n_polys])):
             res = 0
-        for t in range(n_odd):
+        for t in range(n_odd):      # every ring marked RING_THROUGH is listed too
             odd[odd_rings[t]] = 0
         r += 1
     free(B.first)
@@ -577,8 +645,8 @@ cdef int _rings_placed(const double* xy, Py_ssize_t n, const int64_t* seg,
 
 cdef int _representatives(const int64_t* seg, const Py_ssize_t* start, Py_ssize_t n_rings,
                           const Touches* found, Py_ssize_t n, int64_t* rep) noexcept nogil:
-    """rep[r] = ring r's first vertex that touches no other ring; 1, 0 when a ring
-    has none, -1 when out of memory."""
+    """rep[r] = ring r's first vertex that touches no other ring, or ~ its first
+    vertex when every vertex does; 1, or -1 when out of memory."""
     cdef Py_ssize_t t, r, k
     cdef uint8_t* touched = <uint8_t*> calloc(n if n > 0 else 1, 1)
     if touched == NULL:
@@ -592,35 +660,48 @@ cdef int _representatives(const int64_t* seg, const Py_ssize_t* start, Py_ssize_
                 rep[r] = seg[2 * k]
                 break
         if rep[r] < 0:
-            free(touched)
-            return 0
+            rep[r] = ~seg[2 * start[r]]
     free(touched)
     return 1
 
 
-cdef int _touches_valid(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
-                        const int64_t* seg_ring, const int64_t* ring_poly,
-                        Py_ssize_t n_rings, const Touches* found) noexcept nogil:
+cdef int _ring_links(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
+                     const int64_t* seg_ring, const Py_ssize_t* start, Py_ssize_t n_rings,
+                     RingLinks* L) noexcept nogil:
+    """Fill L (its arrays malloc'ed: the caller frees L.nextv and L.ccw).  A ring's
+    orientation is the turn at its lowest vertex (least x, then least y), which is
+    never flat: the ring is simple and does not fold back.  0, or -1 when out of
+    memory."""
+    cdef Py_ssize_t k, r
+    cdef int64_t low, v
+    L.nextv = <int64_t*> malloc(3 * n * sizeof(int64_t))
+    L.ccw = <uint8_t*> malloc(n_rings if n_rings > 0 else 1)
+    if L.nextv == NULL or L.ccw == NULL:
+        return -1
+    L.prevv = &L.nextv[n]
+    L.vring = &L.nextv[2 * n]
+    for k in range(m):
+        L.nextv[seg[2 * k]] = seg[2 * k + 1]
+        L.prevv[seg[2 * k + 1]] = seg[2 * k]
+        L.vring[seg[2 * k]] = seg_ring[k]
+    for r in range(n_rings):
+        low = seg[2 * start[r]]
+        for k in range(start[r], start[r + 1]):
+            v = seg[2 * k]
+            if xy[2 * v] < xy[2 * low] or (xy[2 * v] == xy[2 * low]
+                                           and xy[2 * v + 1] < xy[2 * low + 1]):
+                low = v
+        L.ccw[r] = orient2d(&xy[2 * L.prevv[low]], &xy[2 * low], &xy[2 * L.nextv[low]]) > 0
+    return 0
+
+
+cdef int _touches_valid(const RingLinks* L, const double* xy, const int64_t* ring_poly,
+                        Py_ssize_t n, Py_ssize_t n_rings, const Touches* found) noexcept nogil:
     """The touches _no_contacts found cross nothing and close no cycle; 1, 0, or -1
     when out of memory."""
-    cdef Py_ssize_t k
-    cdef int res
-    cdef int64_t* nextv = <int64_t*> malloc(3 * n * sizeof(int64_t))
-    cdef int64_t* prevv
-    cdef int64_t* vring
-    if nextv == NULL:
-        return -1
-    prevv = &nextv[n]
-    vring = &nextv[2 * n]
-    for k in range(m):
-        nextv[seg[2 * k]] = seg[2 * k + 1]
-        prevv[seg[2 * k + 1]] = seg[2 * k]
-        vring[seg[2 * k]] = seg_ring[k]
-    res = 1 if _touches_cross_free(xy, found, nextv, prevv) else 0
-    if res == 1:
-        res = _touches_acyclic(found, vring, ring_poly, n, n_rings)
-    free(nextv)
-    return res
+    if not _touches_cross_free(xy, found, L.nextv, L.prevv):
+        return 0
+    return _touches_acyclic(found, L.vring, ring_poly, n, n_rings)
 
 
 cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const int64_t* edge,
@@ -636,6 +717,7 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
     cdef Py_ssize_t n_rings, k, r
     cdef int res
     cdef Touches found
+    cdef RingLinks links
     if n_polys < 1 or m < 3 or first_ring[0] != 0:
         return 0
     for k in range(n_polys):
@@ -644,6 +726,8 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
     n_rings = first_ring[n_polys]
     found.pair = NULL
     found.n = found.cap = 0
+    links.nextv = links.prevv = links.vring = NULL
+    links.ccw = NULL
     start = <Py_ssize_t*> malloc((n_rings + 1) * sizeof(Py_ssize_t))
     per_ring = <int64_t*> malloc((2 * n_rings + m) * sizeof(int64_t))
     if start == NULL or per_ring == NULL:
@@ -663,14 +747,17 @@ cdef int rings_valid(const double* xy, Py_ssize_t n, const int64_t* seg, const i
     if res == 1:
         res = _no_contacts(xy, n, seg, &per_ring[2 * n_rings], n_rings, m, &found)
     if res == 1 and found.n:
-        res = _touches_valid(xy, n, seg, m, &per_ring[2 * n_rings], &per_ring[n_rings],
-                             n_rings, &found)
+        res = _ring_links(xy, n, seg, m, &per_ring[2 * n_rings], start, n_rings, &links)
+        if res == 0:
+            res = _touches_valid(&links, xy, &per_ring[n_rings], n, n_rings, &found)
     if res == 1:
         res = _representatives(seg, start, n_rings, &found, n, per_ring)
     if res == 1 and n_rings > 1:
-        res = _rings_placed(xy, n, seg, &per_ring[2 * n_rings], m, per_ring,
-                            &per_ring[n_rings], first_ring, n_rings, n_polys)
+        res = _rings_placed(xy, n, seg, &per_ring[2 * n_rings], m, per_ring, &links,
+                            &found, &per_ring[n_rings], first_ring, n_rings, n_polys)
     free(start)
     free(per_ring)
     free(found.pair)
+    free(links.nextv)
+    free(links.ccw)
     return res

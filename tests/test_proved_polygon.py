@@ -227,6 +227,42 @@ PINNED = {
         True,
     ),
     "one part of a multipolygon": (MultiPolygon([Polygon(SQUARE)]), True, True),
+    # every corner of a ring touching others: placed from a touched corner
+    "a square touching others at all its corners": (
+        MultiPolygon(
+            [box(i, j, i + 1, j + 1) for i in range(3) for j in range(3) if (i + j) % 2 == 0]
+        ),
+        True,
+        True,
+    ),
+    "a part touching the hole it is in at all its corners": (
+        MultiPolygon(
+            [
+                Polygon(SQUARE, [[(1, 1), (2, 1), (3, 1), (3, 2), (3, 3), (2, 3), (1, 3), (1, 2)]]),
+                Polygon([(2, 1), (3, 2), (2, 3), (1, 2)]),
+            ]
+        ),
+        True,
+        True,
+    ),
+    "a hole touching others at all its corners": (
+        Polygon(
+            [(0, 0), (6, 0), (6, 6), (0, 6)],
+            [[(0, 0), (2, 1), (1, 2)], [(2, 1), (4, 1), (3, 2)], [(1, 2), (2, 4), (1, 4)]],
+        ),
+        True,
+        True,
+    ),
+    "a part inside another, touching it at all its corners": (
+        MultiPolygon(
+            [
+                Polygon([(0, 0), (1, 0), (2, 0), (2, 1), (2, 2), (1, 2), (0, 2), (0, 1)]),
+                Polygon([(1, 0), (2, 1), (1, 2), (0, 1)]),
+            ]
+        ),
+        False,
+        False,
+    ),
     "parts touching at a corner": (MultiPolygon([box(0, 0, 1, 1), box(1, 1, 2, 2)]), True, True),
     "parts touching at two points": (
         MultiPolygon(
