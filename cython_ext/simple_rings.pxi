@@ -23,7 +23,10 @@
 # ring at once over the segments of the ray's horizontal band (by exact orient2d and
 # exact comparisons of y): that vertex lies on no other ring, so no count is
 # ambiguous, and a ring that meets another only at touches where it does not cross
-# it lies wholly on one side.
+# it lies wholly on one side.  When every vertex of a ring touches another ring, the
+# ray starts at a touched vertex, and each ring through it is placed by the angle the
+# first ring's edges leave into there (its inside or outside, by its exact
+# orientation).
 #
 # Uses: inputs.pxi (box_of); predicates.pxi (orient2d); nearby.pxi (_Grid, _grid_build);
 # background.pxi (int64_order).
