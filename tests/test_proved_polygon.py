@@ -338,6 +338,18 @@ def test_a_polygon_with_many_holes_apart_is_proved_and_meshed(checked):
     assert abs(mesh.area() - poly.area) < 1e-9 * poly.area
 
 
+def test_a_thousand_holes_are_placed_without_a_test_per_ring_pair():
+    # 900 holes in rows, each touching the next: the rings are placed by their rays'
+    # crossings over a band's segments, not ring by ring against every other ring
+    holes = [
+        [(i + 0.1, j + 0.5), (i + 0.5, j + 0.2), (i + 1.1, j + 0.5), (i + 0.5, j + 0.8)]
+        for i in range(30)
+        for j in range(30)
+    ]
+    poly = Polygon([(0, 0), (32, 0), (32, 31), (0, 31)], holes)
+    assert check_against_geos(poly)
+
+
 def test_rings_proved_valid_refuses_indices_outside_its_arrays():
     pts = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
     edge = np.arange(3, dtype=np.int64)

@@ -186,8 +186,7 @@ def _noded(
 ) -> Domain:
     """_from_shapely's Domain from the rings' arrays (_ring_arrays); `apart`: the
     rings are known to meet nowhere but at common vertices (see merge_and_node),
-    ring_polygon: then the
-    polygon of each ring, for the Domain."""
+    ring_polygon: then the polygon of each ring, for the Domain."""
     n_rings = len(rings[5])
     verts, segs, edges, source, mids, source_names = _with_lines(rings, lines, line_names, points)
     edge_source = source.astype(np.int32)
@@ -221,9 +220,9 @@ def proved_polygon(domain: Polygon | MultiPolygon) -> Domain | None:
     proves valid (rings_proved_valid: simple, meeting at most at common vertices where
     none crosses another and a polygon's own touches close no cycle, holes in place,
     parts apart or touching so), without GEOS's validity check, which costs more than
-    the rest of the conversion on a small polygon; None when anything is not plainly fine (empty, z
-    values, a coordinate not finite or out of range, rings not proved), and
-    from_geometry then decides, with its messages.  The Domain is the one
+    the rest of the conversion on a small polygon; None when anything is not plainly
+    fine (empty, z values, a coordinate not finite or out of range, rings not
+    proved), and from_geometry then decides, with its messages.  The Domain is the one
     from_geometry makes."""
     coords = shapely.get_coordinates(domain)
     if (
