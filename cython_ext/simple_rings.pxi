@@ -44,8 +44,10 @@ cdef Py_ssize_t SWEEP_MAX_RINGS = 16
 # The placement's work allowed per segment (the segments tested against the rays of
 # the rings' vertices) before leaving the proof to GEOS: a few per segment on the
 # rings people draw, but a thousand holes stacked along one horizontal line would
-# each test the others' segments.
-cdef int64_t PLACEMENT_TESTS_PER_SEGMENT = 64
+# each test the others' segments.  Tall thin parts side by side put many segments in
+# every band: poly2tri-sketchup's 63 tiles need more than 64 a segment, and are
+# proved in 0.2 ms with 256.
+cdef int64_t PLACEMENT_TESTS_PER_SEGMENT = 256
 # Entries per segment allowed in the placement's bands before they are made coarser:
 # long edges across many bands (tall thin parts) would otherwise fill many each.
 cdef int64_t BAND_ENTRIES_PER_SEGMENT = 8
