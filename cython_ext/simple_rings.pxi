@@ -28,8 +28,8 @@
 # first ring's edges leave into there (its inside or outside, by its exact
 # orientation).
 #
-# Uses: inputs.pxi (box_of); predicates.pxi (orient2d); nearby.pxi (_Grid, _grid_build);
-# background.pxi (int64_order).
+# Uses: inputs.pxi (box_of); predicates.pxi (orient2d); nearby.pxi (_Grid, _grid_build,
+# _cell); background.pxi (int64_order).
 from libc.stdint cimport int64_t, uint8_t
 from libc.stdlib cimport malloc, realloc, free, qsort
 
@@ -113,18 +113,6 @@ cdef int _ring_starts(const int64_t* seg, const int64_t* edge, const int64_t* ri
     return 1
 
 
-cdef inline Py_ssize_t _slab(double x, double base, double scale, Py_ssize_t last) noexcept nogil:
-    # the band of coordinate x: a monotone function of x (a rounded
-    # subtraction, a product with a positive number, a truncation, a clamp), so that
-    # a range ending in an earlier slab than another begins ends before it
-    cdef double t = (x - base) * scale
-    if not t > 0.0:
-        return 0
-    if t >= last:
-        return last
-    return <Py_ssize_t> t
-
-
 cdef struct Touches:
     # The touches the search found: pairs of vertices of two rings at one point (a
     # pair once for each pair of their edges, so up to four times).
@@ -198,7 +186,8 @@ cdef int _swept_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
     """_no_contacts by a sweep along the box's longer side, slab by slab (m slabs,
     segments in the slab their range begins in, a counting sort): a segment is tested
     against the active ones, and leaves them once the slab its range ends in is
-    behind."""
+    behind.  A slab is nearby.pxi's _cell, monotone in the coordinate, so a range
+    ending in an earlier slab than another begins ends before it."""
     cdef Py_ssize_t i, j, t, k, q, n_active = 0, axis, slab
     cdef int64_t tests = 0, cap = PROOF_TESTS_PER_SEGMENT * m
     cdef int res = 1
@@ -232,8 +221,8 @@ cdef int _swept_contacts(const double* xy, Py_ssize_t n, const int64_t* seg,
     for i in range(m + 1):
         first[i] = 0
     for k in range(m):
-        begins[k] = _slab(bb[4 * k], box[axis], scale, m - 1)
-        ends[k] = _slab(bb[4 * k + 1], box[axis], scale, m - 1)
+        begins[k] = _cell(bb[4 * k], box[axis], scale, m)
+        ends[k] = _cell(bb[4 * k + 1], box[axis], scale, m)
         first[begins[k] + 1] += 1
     for i in range(m):
         first[i + 1] += first[i]
@@ -431,14 +420,14 @@ cdef struct Bands:
     Py_ssize_t* first
     Py_ssize_t* seg_of
     double base, scale
-    Py_ssize_t nb, last
+    Py_ssize_t nb
 
 
 cdef inline void _band_range(const double* xy, const int64_t* seg, Py_ssize_t k,
                              const Bands* B, Py_ssize_t* lo, Py_ssize_t* hi) noexcept nogil:
     cdef double y0 = xy[2 * seg[2 * k] + 1], y1 = xy[2 * seg[2 * k + 1] + 1]
-    lo[0] = _slab(min(y0, y1), B.base, B.scale, B.last)
-    hi[0] = _slab(max(y0, y1), B.base, B.scale, B.last)
+    lo[0] = _cell(min(y0, y1), B.base, B.scale, B.nb)
+    hi[0] = _cell(max(y0, y1), B.base, B.scale, B.nb)
 
 
 cdef int _bands(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m,
@@ -456,7 +445,6 @@ cdef int _bands(const double* xy, Py_ssize_t n, const int64_t* seg, Py_ssize_t m
     B.nb = m
     while True:
         B.scale = B.nb / (box[3] - box[1]) if box[3] > box[1] else 0.0
-        B.last = B.nb - 1
         total = 0
         for k in range(m):
             _band_range(xy, seg, k, B, &lo, &hi)
@@ -499,11 +487,11 @@ cdef int _ray_parities(const double* xy, const int64_t* seg, const int64_t* seg_
                        int64_t* tests) noexcept nogil:
     """odd[q] & RING_ODD = the parity of the crossings of the ray from p towards +x
     with ring q's segments, for every ring but r (p's own) and those marked
-    RING_THROUGH; the rings crossed at all
-    into odd_rings (n_odd of them, marked RING_LISTED).  An edge counts when one end
-    lies above p's y and the other not, and p lies left of it taken upwards.  1, or 0
-    when p lies on an edge (nothing is proved)."""
-    cdef Py_ssize_t b = _slab(p[1], B.base, B.scale, B.last), t, k
+    RING_THROUGH; the rings crossed at all into odd_rings (n_odd of them, marked
+    RING_LISTED).  An edge counts when one end lies above p's y and the other not, and
+    p lies left of it taken upwards.  1, or 0 when p lies on an edge (nothing is
+    proved)."""
+    cdef Py_ssize_t b = _cell(p[1], B.base, B.scale, B.nb), t, k
     cdef const double* a
     cdef const double* c
     cdef int o
