@@ -1290,87 +1290,63 @@ def bounding_box(const double[:, ::1] xy):
     return (box[0], box[1]), (box[2], box[3])
 
 
-def edges_to_sample(const int64_t[::1] keys, const int64_t[::1] passed, int64_t n,
-                    const double[:, ::1] xy):
-    """Of the sorted edge keys a n + b, those not in the sorted array `passed`, with
-    their ends (m, 2), midpoints (m, 2) and lengths (m,): the start of a round of
-    sizing.py's _resolve_callable (resolve.pxi)."""
-    cdef int64_t m = keys.shape[0], k, i, nv = xy.shape[0]
-    cdef int64_t ok = 1
-    if n <= 0:
-        raise ValueError(f"edge keys need a positive n, got {n}")
-    out_arr = np.empty(m, dtype=np.int64)
-    cdef int64_t[::1] out = out_arr
-    if m == 0:
-        return out_arr, np.empty((0, 2), np.int64), np.empty((0, 2)), np.empty(0)
-    with nogil:
-        k = keys_not_in(&keys[0], m, &passed[0] if passed.shape[0] else NULL,
-                        passed.shape[0], &out[0])
-        for i in range(k):
-            if out[i] < 0 or out[i] // n >= nv or out[i] % n >= nv:
-                ok = 0
-    if not ok:
-        raise ValueError(f"an edge key names a vertex beyond the {nv} points")
-    ends_arr = np.empty((k, 2), dtype=np.int64)
-    mid_arr = np.empty((k, 2), dtype=np.float64)
-    length_arr = np.empty(k, dtype=np.float64)
-    cdef int64_t[:, ::1] ends = ends_arr
-    cdef double[:, ::1] mid = mid_arr
-    cdef double[::1] length = length_arr
-    if k:
-        with nogil:
-            edge_geometry(&xy[0, 0], &out[0], k, n, &ends[0, 0], &mid[0, 0], &length[0])
-    return out_arr[:k], ends_arr, mid_arr, length_arr
-
-
-def midpoints_to_insert(const int64_t[::1] keys, const int64_t[:, ::1] ends,
-                        const double[:, ::1] mid, const double[::1] length,
-                        const double[::1] um, const double[::1] u,
-                        const int64_t[::1] passed, double tolerance, double span,
-                        double coarsest, double thin):
-    """The end of a round of _resolve_callable, from the sampled edges (keys, ends,
-    mid, length as edges_to_sample gave them) and the callable's values um at their
-    midpoints and u at the points: (passed with the edges that passed this round,
-    sorted; the indices of the midpoints to insert, increasing), see resolve.pxi."""
-    cdef int64_t m = keys.shape[0], i, n_bad = 0, n_good = 0, n_keep
-    cdef int64_t nu = u.shape[0]
-    cdef bint ok = True
-    if not (ends.shape[0] == mid.shape[0] == length.shape[0] == um.shape[0] == m):
-        raise ValueError("keys, ends, mid, length and um differ in length")
-    if m == 0:
-        return np.array(passed, dtype=np.int64), np.zeros(0, dtype=np.int64)
-    bad_arr = np.empty(m, dtype=np.int64)
-    good_arr = np.empty(m, dtype=np.int64)
-    merged_arr = np.empty(m + passed.shape[0], dtype=np.int64)
-    cdef int64_t[::1] bad = bad_arr, good = good_arr, merged = merged_arr
-    cdef const int64_t* pass_p = &passed[0] if passed.shape[0] else NULL
-    cdef int64_t* good_p = &good[0]
-    cdef int64_t* bad_p = &bad[0]
-    cdef CellKey* cells = <CellKey*> malloc(m * sizeof(CellKey))
-    if cells == NULL:
-        raise MemoryError()
+def resolve_rounds(Triangulation tri, const double[::1] u, object sample, object rounds_of,
+                   int64_t budget, int max_rounds, double tolerance, double span,
+                   double coarsest, double thin):
+    """sizing.py's _resolve_callable, every round in one call: the edges of tri not
+    yet sampled, sample(mid) (the callable's checked sizes at their (k, 2) midpoints,
+    one call a round), the midpoints to insert (edges_to_sample and
+    midpoints_to_insert's steps) and their insertion in BRIO order (rounds_of(n): the
+    round keys of n points), until a round finds nothing to sample or to insert, the
+    samples would pass `budget`, or after max_rounds rounds.  u: the size at each
+    vertex of tri.  Returns (points, u) of every vertex of tri after the rounds."""
+    cdef Tri* T = &tri.T
+    cdef Resolve R
+    cdef int64_t k, n_keep, calls = 0
+    cdef int res = 0, _r
+    cdef double* mid
+    cdef const double* um
+    cdef const int64_t* keys
+    if u.shape[0] != T.nv:
+        raise ValueError(f"u needs one size per vertex ({T.nv}), got {u.shape[0]}")
+    memset(&R, 0, sizeof(Resolve))
+    R.n = T.nv + budget
     try:
-        with nogil:
-            for i in range(m):
-                if not (0 <= ends[i, 0] < nu and 0 <= ends[i, 1] < nu):
-                    ok = False
-                    break
-                if too_coarse(u[ends[i, 0]], u[ends[i, 1]], um[i], length[i], tolerance,
-                              span, coarsest):
-                    bad[n_bad] = i
-                    n_bad += 1
-                else:
-                    good[n_good] = keys[i]
-                    n_good += 1
-            if ok:
-                merge_sorted(pass_p, passed.shape[0], good_p, n_good, &merged[0])
-                n_keep = one_per_cell(&mid[0, 0], &length[0], bad_p, n_bad, thin, cells,
-                                      good_p)
+        if _grow(<void**> &R.u, (T.nv + 1) * sizeof(double)):
+            raise MemoryError()
+        if T.nv:
+            memcpy(R.u, &u[0], T.nv * sizeof(double))
+        for _r in range(max_rounds):
+            k = resolve_unsampled(T, &R)
+            _raise_for(T, <int> min(k, 0))
+            if k == 0 or calls + k > budget:
+                break
+            mid_arr = np.empty((k, 2), dtype=np.float64)
+            mid = _f64v(mid_arr)
+            edge_geometry(T.xy, R.out, k, R.n, R.ends, mid, R.length)
+            um_arr = np.ascontiguousarray(sample(mid_arr), dtype=np.float64)
+            if um_arr.shape != (k,):
+                raise ValueError(f"sample gave shape {um_arr.shape} for {k} midpoints")
+            um = _f64v(um_arr)
+            calls += k
+            n_keep = resolve_coarse(&R, k, mid, um, tolerance, span, coarsest, thin)
+            _raise_for(T, <int> min(n_keep, 0))
+            if n_keep == 0:
+                break
+            rounds_arr = np.ascontiguousarray(rounds_of(n_keep), dtype=np.int64)
+            if rounds_arr.shape != (n_keep,):
+                raise ValueError(f"rounds_of gave shape {rounds_arr.shape} for {n_keep} points")
+            keys = <const int64_t*> _buffer_of(rounds_arr)
+            res = resolve_insert(T, &R, mid, um, n_keep, keys)
+            _raise_for(T, res)
+        points_arr = np.empty((T.nv, 2), dtype=np.float64)
+        u_arr = np.empty(T.nv, dtype=np.float64)
+        if T.nv:
+            memcpy(_f64v(points_arr), T.xy, 2 * T.nv * sizeof(double))
+            memcpy(_f64v(u_arr), R.u, T.nv * sizeof(double))
     finally:
-        free(cells)
-    if not ok:
-        raise ValueError(f"an edge's end is beyond the {nu} sizes")
-    return merged_arr[:passed.shape[0] + n_good], good_arr[:n_keep].copy()
+        resolve_free(&R)
+    return points_arr, u_arr
 
 
 def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds,

@@ -1,14 +1,19 @@
-# One round of sampling a size callable (src/aftmesh/sizing.py's _resolve_callable),
+# The rounds of sampling a size callable (src/aftmesh/sizing.py's _resolve_callable),
 # without the call itself: which background edges to sample, and of those whose
-# samples show the background too coarse, which midpoints to insert.  Python calls the
-# callable once per round between the two; every other step of a round is here, so a
-# round costs a few passes over flat arrays instead of some twenty numpy calls.
+# samples show the background too coarse, which midpoints to insert.  The callable is
+# called once per round between the two (resolve_rounds, _kernel.pyx, calls back into
+# Python for it); every other step of a round is here, so a round costs a few passes
+# over flat arrays instead of some twenty numpy calls.  edges_to_sample and
+# midpoints_to_insert (_kernel.pyx) give one round's two halves to Python on their
+# own.
 #
 # Edges are int64 keys a n + b (a < b), sorted, as Triangulation.edge_keys gives them.
 #
-# Uses: nothing else of the kernel.
+# Uses: for the rounds in one call (the end of this file), triangulation.pxi
+# (add_vertex, insert_vertex, _grow), background.pxi (finite_edge_keys,
+# BRIO_HILBERT_BITS), ordering.pxi (hilbert_keys_into), inputs.pxi (stable_order).
 from libc.math cimport floor, log2, ldexp, fabs, sqrt
-from libc.stdlib cimport qsort
+from libc.stdlib cimport qsort, malloc, free
 from libc.stdint cimport int64_t
 
 
@@ -133,3 +138,119 @@ cdef bint too_coarse(double ua, double ub, double um, double length, double tole
     longer than coarsest sizes (sizing.py's RESOLVE_* say why)."""
     cdef bint miss = fabs(0.5 * (ua + ub) - um) > tolerance * um
     return (miss and length > span * um) or length > coarsest * um
+
+
+# ---------------------------------------------------------------- the rounds in one call
+# resolve_rounds (_kernel.pyx) runs every round of _resolve_callable with these three
+# steps between the callable's calls: the edges not yet sampled, which of them are too
+# coarse, and the insertion of the kept midpoints, each on buffers kept across rounds
+# (Resolve), so a round costs no numpy call but the midpoints handed to the callable.
+
+cdef struct Resolve:
+    int64_t n           # the edge keys' base: more than any vertex index of the rounds
+    int64_t npass       # passed[0:npass]: the sorted keys of the edges that passed
+    int64_t* passed
+    int64_t* keys       # the round's edge keys (3 T.nt), then scratch for the merge
+    int64_t* ring       # one vertex's neighbours (T.nv)
+    int64_t* out        # the edges to sample (k), their ends (2 k) and lengths (k)
+    int64_t* ends
+    double* length
+    int64_t* bad        # the too coarse ones (k)
+    int64_t* good       # the ones that passed, then the midpoints kept (k)
+    CellKey* cells      # one_per_cell's (k)
+    double* u           # the size at every vertex (T.nv)
+
+
+cdef void resolve_free(Resolve* R) noexcept nogil:
+    free(R.passed)
+    free(R.keys)
+    free(R.ring)
+    free(R.out)
+    free(R.ends)
+    free(R.length)
+    free(R.bad)
+    free(R.good)
+    free(R.cells)
+    free(R.u)
+
+
+cdef int64_t resolve_unsampled(Tri* T, Resolve* R) noexcept nogil:
+    """The edges of T's finite triangles not in R.passed into R.out (sorted), with
+    room for their ends, lengths and verdicts; returns how many, or an error."""
+    cdef int64_t m, k
+    if (_grow(<void**> &R.keys, (3 * T.nt + 1) * sizeof(int64_t))
+            or _grow(<void**> &R.ring, (T.nv + 1) * sizeof(int64_t))):
+        return ERR_NOMEM
+    m = finite_edge_keys(T, R.n, R.keys, R.ring)
+    if _grow(<void**> &R.out, (m + 1) * sizeof(int64_t)):
+        return ERR_NOMEM
+    k = keys_not_in(R.keys, m, R.passed, R.npass, R.out)
+    if (_grow(<void**> &R.ends, 2 * (k + 1) * sizeof(int64_t))
+            or _grow(<void**> &R.length, (k + 1) * sizeof(double))
+            or _grow(<void**> &R.bad, (k + 1) * sizeof(int64_t))
+            or _grow(<void**> &R.good, (k + 1) * sizeof(int64_t))
+            or _grow(<void**> &R.cells, (k + 1) * sizeof(CellKey))):
+        return ERR_NOMEM
+    return k
+
+
+cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid, const double* um,
+                            double tolerance, double span, double coarsest,
+                            double thin) noexcept nogil:
+    """midpoints_to_insert's verdicts on the k sampled edges: the passed ones merged
+    into R.passed, the midpoints to insert (one per thinning cell) into R.good (its
+    passed keys merged by then), in increasing order; returns how many, or an
+    error."""
+    cdef int64_t i, n_bad = 0, n_good = 0
+    cdef int64_t* merged
+    for i in range(k):
+        if too_coarse(R.u[R.ends[2 * i]], R.u[R.ends[2 * i + 1]], um[i], R.length[i],
+                      tolerance, span, coarsest):
+            R.bad[n_bad] = i
+            n_bad += 1
+        else:
+            R.good[n_good] = R.out[i]
+            n_good += 1
+    # the merge goes to R.keys (this round's edge keys are no longer needed), which
+    # then becomes R.passed
+    if _grow(<void**> &R.keys, (R.npass + n_good + 1) * sizeof(int64_t)):
+        return ERR_NOMEM
+    R.npass = merge_sorted(R.passed, R.npass, R.good, n_good, R.keys)
+    merged = R.keys
+    R.keys = R.passed
+    R.passed = merged
+    return one_per_cell(mid, R.length, R.bad, n_bad, thin, R.cells, R.good)
+
+
+cdef int resolve_insert(Tri* T, Resolve* R, const double* mid, const double* um,
+                        int64_t n_keep, const int64_t* rounds) noexcept nogil:
+    """Insert the kept midpoints R.good[0:n_keep] in their BRIO order (rounds: the
+    round keys of n_keep points), each walk started at a triangle of its edge's first
+    end, as Triangulation.add_points does; their sizes join R.u."""
+    cdef int64_t i, j
+    cdef int v, res = 0, start, near, nv0 = T.nv
+    cdef double* xy = <double*> malloc((2 * n_keep + 1) * sizeof(double))
+    cdef int64_t* keys = <int64_t*> malloc((3 * n_keep + 1) * sizeof(int64_t))
+    if xy == NULL or keys == NULL or _grow(<void**> &R.u, (nv0 + n_keep) * sizeof(double)):
+        free(xy)
+        free(keys)
+        return ERR_NOMEM
+    for i in range(n_keep):
+        xy[2 * i] = mid[2 * R.good[i]]
+        xy[2 * i + 1] = mid[2 * R.good[i] + 1]
+    hilbert_keys_into(xy, n_keep, BRIO_HILBERT_BITS, keys)
+    for i in range(n_keep):
+        keys[i] |= rounds[i]
+    stable_order(keys, _key_less, n_keep, &keys[n_keep], &keys[2 * n_keep])
+    for i in range(n_keep):
+        j = R.good[keys[n_keep + i]]
+        near = <int> R.ends[2 * j]
+        start = tri_of(T.vhe[near]) if 0 <= near < T.nv and T.vhe[near] >= 0 else NONE
+        v = add_vertex(T, mid[2 * j], mid[2 * j + 1])
+        res = v if v < 0 else insert_vertex(T, v, start)
+        if res < 0:
+            break
+        R.u[nv0 + i] = um[j]
+    free(xy)
+    free(keys)
+    return res if res < 0 else 0

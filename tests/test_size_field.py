@@ -187,7 +187,9 @@ def test_compiled_chains_equal_the_numpy_chains():
 
 def _numpy_round(keys, passed, n, xy, size, u, thin):
     """One round of the callable's sampling as numpy states it (the definition the
-    kernel's edges_to_sample and midpoints_to_insert compute, resolve.pxi)."""
+    kernel's resolve_rounds computes, resolve.pxi): the edges to sample, their
+    midpoints and sizes there, the passed edges after the round, the midpoints to
+    insert."""
     from aftmesh.sizing import RESOLVE_COARSEST, RESOLVE_SPAN, RESOLVE_TOLERANCE
 
     keys = keys[~np.isin(keys, passed)]
@@ -210,55 +212,91 @@ def _numpy_round(keys, passed, n, xy, size, u, thin):
     return keys, mid, um, np.sort(np.concatenate([passed, keys[~bad]])), np.sort(at[order[first]])
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_kernel_sampling_round_is_the_numpy_round(seed):
-    """A round of the size callable's sampling in the kernel (which edges to sample,
-    which midpoints to insert, what passed) gives exactly the numpy definition's
-    arrays, on a random background with some edges passed before."""
+def _numpy_rounds(xy, u, size, budget, rounds):
+    """sizing._resolve_callable's rounds as numpy states them, each round's midpoints
+    inserted in BRIO order with their walks started at their edges' first ends:
+    (points, sizes) at the end."""
     from aftmesh import _kernel
+    from aftmesh._order import brio_order
+    from aftmesh.sizing import RESOLVE_THIN
+
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(brio_order(xy))
+    n, passed, calls = len(xy) + budget, np.zeros(0, np.int64), 0
+    for _ in range(rounds):
+        keys, mid, um, after, at = _numpy_round(
+            tri.edge_keys(n), passed, n, xy, size, u, RESOLVE_THIN
+        )
+        if len(keys) == 0 or calls + len(keys) > budget:
+            break
+        calls, passed = calls + len(keys), after
+        if len(at) == 0:
+            break
+        at = at[brio_order(mid[at])]
+        tri.add_points(np.ascontiguousarray(mid[at]), (keys[at] // n).astype(np.int32))
+        xy, u = np.concatenate([xy, mid[at]]), np.concatenate([u, um[at]])
+    return xy, u
+
+
+def _kernel_rounds(xy, u, size, budget, rounds):
+    from aftmesh import _kernel
+    from aftmesh._order import brio_order, round_keys
     from aftmesh.sizing import RESOLVE_COARSEST, RESOLVE_SPAN, RESOLVE_THIN, RESOLVE_TOLERANCE
 
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(brio_order(xy))
+    return _kernel.resolve_rounds(
+        tri, u, lambda mid: size(mid[:, 0], mid[:, 1]), round_keys, budget, rounds,
+        RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("seed", "budget", "rounds"), [(0, 20_000, 24), (1, 20_000, 24), (2, 20_000, 2), (3, 1_500, 24)]
+)
+def test_kernel_sampling_rounds_are_the_numpy_rounds(seed, budget, rounds):
+    """The size callable's sampling rounds in the kernel (which edges to sample, which
+    midpoints to insert, in what order, what passed) give exactly the points and sizes
+    of the numpy definition, round after round, on a random background; stopped by
+    the rounds, the evaluations' budget or a round with nothing to insert."""
     rng = np.random.default_rng(seed)
     xy = rng.uniform(-3, 7, (300, 2))
-    tri = _kernel.Triangulation(xy)
-    tri.insert_points(np.arange(len(xy), dtype=np.int32))
-    n = len(xy) + 10
-    all_keys = tri.edge_keys(n)
-    passed = np.sort(rng.choice(all_keys, len(all_keys) // 3, replace=False))
 
     def size(x, y):
         return 0.05 + 0.3 * np.abs(np.sin(x)) * (1 + y * y)
 
     u = size(xy[:, 0], xy[:, 1])
-    keys0, mid0, um, passed0, at0 = _numpy_round(all_keys, passed, n, xy, size, u, RESOLVE_THIN)
-    keys, ends, mid, length = _kernel.edges_to_sample(all_keys, passed, n, xy)
-    assert np.array_equal(keys, keys0) and np.array_equal(mid, mid0)
-    assert np.array_equal(ends, np.c_[keys // n, keys % n])
-    got_passed, at = _kernel.midpoints_to_insert(
-        keys, ends, mid, length, size(mid[:, 0], mid[:, 1]), u, passed,
-        RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
-    )  # fmt: skip
-    assert np.array_equal(got_passed, passed0) and np.array_equal(at, at0)
-    assert 0 < len(at) < len(keys)
+    want = _numpy_rounds(xy, u, size, budget, rounds)
+    got = _kernel_rounds(xy, u, size, budget, rounds)
+    assert len(want[0]) > len(xy)
+    assert np.array_equal(got[0], want[0]) and np.array_equal(got[1], want[1])
 
 
-def test_kernel_sampling_round_refuses_vertices_it_has_no_data_for():
-    """An edge key or end beyond the points or sizes given, or a key base that is not
-    positive, is a ValueError naming the count, not a read past the arrays."""
+def test_kernel_sampling_rounds_refuse_what_they_cannot_use():
+    """Sizes not one per vertex, samples or round keys of the wrong length are a
+    ValueError naming the counts, not a read past the arrays; the callable's own
+    error comes through as it is."""
     from aftmesh import _kernel
+    from aftmesh._order import round_keys
 
-    xy = np.zeros((3, 2))
-    with pytest.raises(ValueError, match="3 points"):
-        _kernel.edges_to_sample(np.array([5], np.int64), np.zeros(0, np.int64), 10, xy)
-    with pytest.raises(ValueError, match="positive n"):
-        _kernel.edges_to_sample(np.array([5], np.int64), np.zeros(0, np.int64), 0, xy)
-    ends = np.array([[0, 7]], dtype=np.int64)
-    one = np.ones(1)
-    with pytest.raises(ValueError, match="3 sizes"):
-        _kernel.midpoints_to_insert(
-            np.array([7], np.int64), ends, np.zeros((1, 2)), one, one, np.ones(3),
-            np.zeros(0, np.int64), 0.2, 1.0, 8.0, 0.5,
-        )  # fmt: skip
+    xy = np.array([[0.0, 0.0], [10.0, 0.0], [0.0, 10.0], [10.0, 10.0]])
+    tri = _kernel.Triangulation(xy)
+    tri.insert_points(np.arange(4, dtype=np.int32))
+    args = (20_000, 24, 0.2, 1.0, 8.0, 0.5)
+    with pytest.raises(ValueError, match=r"one size per vertex \(4\), got 3"):
+        _kernel.resolve_rounds(tri, np.ones(3), lambda m: np.ones(len(m)), round_keys, *args)
+    with pytest.raises(ValueError, match="for 5 midpoints"):
+        _kernel.resolve_rounds(tri, np.ones(4), lambda m: np.ones(2), round_keys, *args)
+    with pytest.raises(ValueError, match="points"):
+        _kernel.resolve_rounds(
+            tri,
+            np.ones(4),
+            lambda m: np.full(len(m), 0.1),
+            lambda n: np.zeros(n + 1, np.int64),
+            *args,
+        )
+    with pytest.raises(ZeroDivisionError):
+        _kernel.resolve_rounds(tri, np.ones(4), lambda m: 1 / 0, round_keys, *args)
 
 
 @pytest.mark.parametrize("n_points", [4, 60, 2000])

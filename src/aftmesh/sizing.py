@@ -146,6 +146,9 @@ class SizeField:
 
 
 def _check_values(h: np.ndarray, X: np.ndarray, Y: np.ndarray, what: str) -> None:
+    # two reductions decide the common case (a NaN fails both comparisons)
+    if h.size == 0 or (h.min() > 0.0 and h.max() < np.inf):
+        return
     bad = ~(np.isfinite(h) & (h > 0))
     if bad.any():
         k = np.flatnonzero(bad.ravel())[0]
@@ -165,10 +168,10 @@ def _resolution(bounds) -> float:
 
 def _check_resolution(h: np.ndarray, X, Y, bounds, what: str) -> None:
     """Refuse sizes finer than the coordinates can resolve (see MIN_SIZE_ULPS)."""
-    magnitude = float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))
     spacing = _resolution(bounds)
     k = int(np.argmin(h))
     if h.ravel()[k] < MIN_SIZE_ULPS * spacing:
+        magnitude = float(np.max(np.abs(np.asarray(bounds, dtype=np.float64))))
         where = "" if X is None else f" at ({X.ravel()[k]:.9g}, {Y.ravel()[k]:.9g})"
         raise InvalidSizeError(
             f"{what} {h.ravel()[k]:.6g}{where} is below what the coordinates can resolve: "
@@ -269,39 +272,28 @@ def _box_corners(bounds) -> np.ndarray:
     return np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=np.float64)
 
 
-def _resolve_callable(size, tri, pts: np.ndarray, u: np.ndarray, bounds):
+def _resolve_callable(size, tri, u: np.ndarray, bounds):
     """Sample the callable at the midpoints of the background's edges, round by round
     (one call each), and split the edges where interpolating between their ends
     misses it (RESOLVE_TOLERANCE) while longer than the size there (RESOLVE_SPAN), or
     where they are longer than RESOLVE_COARSEST sizes, inserting the first midpoint
     in each square cell of side RESOLVE_THIN 2**k among the edges of length in
-    [2**k, 2**(k+1)).  An edge that passed once is not sampled again while it lasts.
-    The kernel does each round's arithmetic (cython_ext/resolve.pxi)."""
-    passed = np.zeros(0, dtype=np.int64)  # sorted edge keys
-    calls = 0
-    n_max = len(pts) + RESOLVE_EVALUATIONS
-    for _ in range(RESOLVE_ROUNDS):
-        keys, ends, mid, length = _kernel.edges_to_sample(tri.edge_keys(n_max), passed, n_max, pts)
-        if len(keys) == 0 or calls + len(keys) > RESOLVE_EVALUATIONS:
-            break
+    [2**k, 2**(k+1)), in spatial order (BRIO: fewer flips than the order of the edges,
+    and the background it gives decides the ties between cocircular points), each
+    walk started at its edge's first end.  An edge that passed once is not sampled
+    again while it lasts.  The kernel runs the rounds (cython_ext/resolve.pxi),
+    calling back here for the samples only.  Returns every background point and the
+    size there."""
+
+    def sample(mid: np.ndarray) -> np.ndarray:
         um = _evaluate(size, mid[:, 0], mid[:, 1])
-        calls += len(keys)
         _check_resolution(um, mid[:, 0], mid[:, 1], bounds, "the size callable gave")
-        passed, at = _kernel.midpoints_to_insert(
-            keys, ends, mid, length, um, u, passed,
-            RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
-        )  # fmt: skip
-        if len(at) == 0:
-            break
-        # spatial order: fewer flips than the order of the edges (and the background
-        # it gives decides the ties between cocircular points)
-        at = at[brio_order(mid[at])]
-        new = np.ascontiguousarray(mid[at])
-        # each midpoint's walk starts at its edge's first end, a few triangles away
-        tri.add_points(new, np.ascontiguousarray(ends[at, 0], dtype=np.int32))
-        pts = np.concatenate([pts, new])
-        u = np.concatenate([u, um[at]])
-    return pts, u
+        return um
+
+    return _kernel.resolve_rounds(
+        tri, u, sample, round_keys, RESOLVE_EVALUATIONS, RESOLVE_ROUNDS,
+        RESOLVE_TOLERANCE, RESOLVE_SPAN, RESOLVE_COARSEST, RESOLVE_THIN,
+    )  # fmt: skip
 
 
 def make_size_field(
@@ -387,7 +379,7 @@ def _callable_field(size, bounds, pts: np.ndarray, lengths: np.ndarray, gradatio
     _check_resolution(u, pts[:, 0], pts[:, 1], bounds, "the size callable gave")
     tri = _kernel.Triangulation(pts)
     tri.insert_points(brio_order(pts))
-    pts, u = _resolve_callable(size, tri, pts, u, bounds)
+    pts, u = _resolve_callable(size, tri, u, bounds)
     lengths = np.concatenate([lengths, np.full(len(pts) - len(lengths), np.inf)])
     tv, nb = tri.finite_triangles()
     used = np.zeros(len(pts), dtype=bool)
