@@ -1295,15 +1295,16 @@ def resolve_rounds(Triangulation tri, const double[::1] u, object sample, object
                    double coarsest, double thin):
     """sizing.py's _resolve_callable, every round in one call: the edges of tri not
     yet sampled, sample(mid) (the callable's checked sizes at their (k, 2) midpoints,
-    one call a round), the midpoints to insert (edges_to_sample and
-    midpoints_to_insert's steps) and their insertion in BRIO order (rounds_of(n): the
-    round keys of n points), until a round finds nothing to sample or to insert, the
+    one call a round), the midpoints to insert and their insertion in BRIO order
+    (rounds_of(n): the round keys of n points; resolve.pxi), until a round finds nothing to sample or to insert, the
     samples would pass `budget`, or after max_rounds rounds.  u: the size at each
-    vertex of tri.  Returns (points, u) of every vertex of tri after the rounds."""
+    vertex of tri.  Returns (points, u) of every vertex of tri after the rounds.  The
+    GIL is released around each round's kernel steps on a large background."""
     cdef Tri* T = &tri.T
     cdef Resolve R
     cdef int64_t k, n_keep, calls = 0
-    cdef int res = 0, _r
+    cdef int _r
+    cdef bint big
     cdef double* mid
     cdef const double* um
     cdef const int64_t* keys
@@ -1311,13 +1312,19 @@ def resolve_rounds(Triangulation tri, const double[::1] u, object sample, object
         raise ValueError(f"u needs one size per vertex ({T.nv}), got {u.shape[0]}")
     memset(&R, 0, sizeof(Resolve))
     R.n = T.nv + budget
+    R.tolerance, R.span, R.coarsest, R.thin = tolerance, span, coarsest, thin
     try:
         if _grow(<void**> &R.u, (T.nv + 1) * sizeof(double)):
             raise MemoryError()
         if T.nv:
             memcpy(R.u, &u[0], T.nv * sizeof(double))
         for _r in range(max_rounds):
-            k = resolve_unsampled(T, &R)
+            big = T.nt >= NOGIL_MIN_ITEMS
+            if big:
+                with nogil:
+                    k = resolve_unsampled(T, &R)
+            else:
+                k = resolve_unsampled(T, &R)
             _raise_for(T, <int> min(k, 0))
             if k == 0 or calls + k > budget:
                 break
@@ -1329,16 +1336,20 @@ def resolve_rounds(Triangulation tri, const double[::1] u, object sample, object
                 raise ValueError(f"sample gave shape {um_arr.shape} for {k} midpoints")
             um = _f64v(um_arr)
             calls += k
-            n_keep = resolve_coarse(&R, k, mid, um, tolerance, span, coarsest, thin)
+            # the round keys of the midpoints kept are a prefix of those of all k
+            # (_order.round_keys), so the rest of the round needs no Python
+            rounds_arr = np.ascontiguousarray(rounds_of(k), dtype=np.int64)
+            if rounds_arr.shape != (k,):
+                raise ValueError(f"rounds_of gave shape {rounds_arr.shape} for {k} points")
+            keys = <const int64_t*> _buffer_of(rounds_arr)
+            if big:
+                with nogil:
+                    n_keep = resolve_finish(T, &R, k, mid, um, keys)
+            else:
+                n_keep = resolve_finish(T, &R, k, mid, um, keys)
             _raise_for(T, <int> min(n_keep, 0))
             if n_keep == 0:
                 break
-            rounds_arr = np.ascontiguousarray(rounds_of(n_keep), dtype=np.int64)
-            if rounds_arr.shape != (n_keep,):
-                raise ValueError(f"rounds_of gave shape {rounds_arr.shape} for {n_keep} points")
-            keys = <const int64_t*> _buffer_of(rounds_arr)
-            res = resolve_insert(T, &R, mid, um, n_keep, keys)
-            _raise_for(T, res)
         points_arr = np.empty((T.nv, 2), dtype=np.float64)
         u_arr = np.empty(T.nv, dtype=np.float64)
         if T.nv:

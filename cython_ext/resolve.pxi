@@ -159,6 +159,10 @@ cdef struct Resolve:
     int64_t* good       # the ones that passed, then the midpoints kept (k)
     CellKey* cells      # one_per_cell's (k)
     double* u           # the size at every vertex (T.nv)
+    double tolerance    # too_coarse's thresholds and one_per_cell's cell (sizing.py's
+    double span         # RESOLVE_*)
+    double coarsest
+    double thin
 
 
 cdef void resolve_free(Resolve* R) noexcept nogil:
@@ -194,9 +198,8 @@ cdef int64_t resolve_unsampled(Tri* T, Resolve* R) noexcept nogil:
     return k
 
 
-cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid, const double* um,
-                            double tolerance, double span, double coarsest,
-                            double thin) noexcept nogil:
+cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid,
+                            const double* um) noexcept nogil:
     """midpoints_to_insert's verdicts on the k sampled edges: the passed ones merged
     into R.passed, the midpoints to insert (one per thinning cell) into R.good (its
     passed keys merged by then), in increasing order; returns how many, or an
@@ -205,7 +208,7 @@ cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid, const doub
     cdef int64_t* merged
     for i in range(k):
         if too_coarse(R.u[R.ends[2 * i]], R.u[R.ends[2 * i + 1]], um[i], R.length[i],
-                      tolerance, span, coarsest):
+                      R.tolerance, R.span, R.coarsest):
             R.bad[n_bad] = i
             n_bad += 1
         else:
@@ -219,7 +222,20 @@ cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid, const doub
     merged = R.keys
     R.keys = R.passed
     R.passed = merged
-    return one_per_cell(mid, R.length, R.bad, n_bad, thin, R.cells, R.good)
+    return one_per_cell(mid, R.length, R.bad, n_bad, R.thin, R.cells, R.good)
+
+
+cdef int64_t resolve_finish(Tri* T, Resolve* R, int64_t k, const double* mid,
+                            const double* um, const int64_t* rounds) noexcept nogil:
+    """The end of a round: resolve_coarse, then resolve_insert of the midpoints kept
+    (rounds: the round keys of k points, of which the kept ones take the first);
+    returns how many were inserted, or an error."""
+    cdef int res
+    cdef int64_t n_keep = resolve_coarse(R, k, mid, um)
+    if n_keep <= 0:
+        return n_keep
+    res = resolve_insert(T, R, mid, um, n_keep, rounds)
+    return res if res < 0 else n_keep
 
 
 cdef int resolve_insert(Tri* T, Resolve* R, const double* mid, const double* um,
