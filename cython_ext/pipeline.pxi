@@ -266,6 +266,7 @@ cdef enum:
     PIECES_RAN = 0            # to the end, or to the kernel error in Pieces.res
     PIECES_DECLINED = 1       # the stages must run instead
     PIECES_INSERT_FAILED = 2  # insert_pslg's error: a crossing or collinear one declines
+    PIECES_BUILT = 3          # the classified CDT, the front still to run
 
 
 cdef struct Pieces:
@@ -297,7 +298,13 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
     stretch: a thread meshing small domains then takes the GIL back once per domain,
     not once per stage (each time it may have to wait for another thread's Python
     work).  The checks between the stages are the stages' own (see generate_common)."""
-    cdef int i, n_unmeshed = 0
+    cdef int outcome = _pieces_cdt(T, merged, P)
+    return _pieces_meshed(T, A, R, P) if outcome == PIECES_BUILT else outcome
+
+
+cdef int _pieces_cdt(Tri* T, int32_t* merged, Pieces* P) noexcept nogil:
+    """_mesh_pieces to the classified CDT (Triangle's hole and region points, the
+    nesting or inside of the rings): PIECES_BUILT, or how it ended."""
     P.res = _insert_pslg(T, P.rounds, P.seg, P.m, True, merged, &P.n_merged, &P.through,
                          &P.failed)
     if P.res < 0:
@@ -316,6 +323,13 @@ cdef int _mesh_pieces(Tri* T, Aft* A, Refine* R, int32_t* merged, Pieces* P) noe
         P.res = _inside_exterior(T, P.piece_edge, P.edge_source)
         if P.res <= 0:
             return PIECES_DECLINED if P.res == 0 else PIECES_RAN
+    return PIECES_BUILT
+
+
+cdef int _pieces_meshed(Tri* T, Aft* A, Refine* R, Pieces* P) noexcept nogil:
+    """_mesh_pieces from the classified CDT on: the stages' checks of its triangles,
+    Basic_aft, smoothing, the minimum-angle pass."""
+    cdef int i, n_unmeshed = 0
     for i in range(T.nt):
         n_unmeshed += T.tstate[i] == T_UNMESHED
     if n_unmeshed == 0 or 0 <= P.max_triangles < n_unmeshed:
@@ -363,11 +377,14 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
                               object holes, object seeds, object seed_ids,
                               long long max_triangles,
                               int smooth_rounds, bint slide, double min_angle,
-                              bint split, int n_corners):
+                              bint split, int n_corners, object classify_cb=None):
     """_mesh_pieces on tri (its size field and options set; split: the minimum-angle
     pass may split input segments), with the def layer's error handling: None where
     the stages must run, else (merged vertices, smoothing moves, the refine pass's
-    counts or None, t_cdt, t_aft)."""
+    counts or None, t_cdt, t_aft).  classify_cb (not None: a region list's pieces)
+    gives the region of each piece of the CDT from its probes and corners
+    (Triangulation.components), as _stages.prepare_front does, between the CDT and the
+    front."""
     cdef Pieces P
     cdef Refine R
     cdef int outcome, nv = tri.T.nv
@@ -410,8 +427,17 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
     tri.A.progress = NULL
     tri._note_thread()
     try:
-        with nogil:
-            outcome = _mesh_pieces(&tri.T, &tri.A, &R, merged, &P)
+        if classify_cb is None:
+            with nogil:
+                outcome = _mesh_pieces(&tri.T, &tri.A, &R, merged, &P)
+        else:
+            with nogil:
+                outcome = _pieces_cdt(&tri.T, merged, &P)
+            if outcome == PIECES_BUILT:
+                comp, probes, corners = tri.components()
+                tri.set_regions(comp, classify_cb(probes, corners))
+                with nogil:
+                    outcome = _pieces_meshed(&tri.T, &tri.A, &R, &P)
     finally:
         refine_free(&R)
     if outcome == PIECES_INSERT_FAILED:
@@ -440,7 +466,8 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                     double progress_limit, int order, long long max_triangles,
                     object min_area, double close_factor, bint swaps, bint greedy,
                     int smooth_rounds, bint slide, double min_angle, bint scaffold,
-                    bint split=True, object given=None, double given_expected=-1.0):
+                    bint split=True, object given=None, double given_expected=-1.0,
+                    object classify_cb=None):
     """The stages of generate from the size field to the refined mesh, for a number
     size, `constant` (0: size=None, the input edges' lengths alone; see the top of
     pipeline.pxi).  classify: the domain is one valid polygon with holes, its rings
@@ -458,7 +485,10 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     whole; given: a size field _stages.size_field made (a callable's, or a SizeField
     the caller passed), as its kernel_args()[1:], used as it is (constant: its
     constant), else None; given_expected: the triangles it asks for as
-    _stages.size_field counted them (< 0: count here).
+    _stages.size_field counted them (< 0: count here).  classify_cb: for a region
+    list (polygons sharing edges), the region of each piece from its probes and
+    corners (regions.classify_pieces on the polygons), called between the CDT and the
+    front; classify is then off.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's
@@ -499,7 +529,7 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
                             ring_polygon, holes, seeds, seed_ids, constant, area, rules,
                             rounds, max_pieces, progress_limit, order, max_triangles,
                             min_area, close_factor, swaps, greedy, smooth_rounds, slide,
-                            min_angle, scaffold, split, given_expected, n)
+                            min_angle, scaffold, split, given_expected, n, classify_cb)
     finally:
         size_field_free(&S)
 
@@ -515,7 +545,7 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
                          long long max_triangles, object min_area, double close_factor,
                          bint swaps, bint greedy, int smooth_rounds, bint slide,
                          double min_angle, bint scaffold, bint split,
-                         double expected_in, Py_ssize_t n):
+                         double expected_in, Py_ssize_t n, object classify_cb):
     """generate_common from its size field on (field: _common_field's arrays, or None
     for the constant), S the kernel's copy of it, which the triangulation takes;
     expected_in: the count of a given field, made already (< 0: none)."""
@@ -570,7 +600,7 @@ cdef object _generate_on(SizeField* S, object field, const double[:, ::1] vertic
     out = _mesh_from_pieces(tri, _round_keys_of(rounds, nv), s_out,
                             e_out if classify else None, edge_source, ring_polygon,
                             holes, seeds, seed_ids, max_triangles, smooth_rounds, slide,
-                            min_angle, split, n)
+                            min_angle, split, n, classify_cb)
     if out is None:
         return None
     n_merged, moves, done, t_cdt, t_aft = out

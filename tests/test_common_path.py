@@ -160,8 +160,7 @@ def test_common_case_takes_rings_dicts_holes_and_hole_points(monkeypatch):
     assert _compare(monkeypatch, holed, 0.2).taken == 1
     assert _compare(monkeypatch, FRAMED, 0.2).taken == 1  # Triangle's hole points
     parts = [box(0, 0, 1, 1), box(1, 0, 2, 1)]
-    taken = _compare(monkeypatch, parts, 0.2)
-    assert taken.taken == taken.declined == 0  # two regions: classified by probes
+    assert _compare(monkeypatch, parts, 0.2).taken == 1  # two regions: by probes
 
 
 @pytest.mark.parametrize("split", [True, False], ids=["split", "whole"])
@@ -415,6 +414,54 @@ def test_common_case_classifies_holes_touching_the_exterior_and_each_other(monke
     )
     assert touching.is_valid
     assert _compare(monkeypatch, touching, 0.2, checked).taken == 1
+
+
+def _voronoi(n: int, seed: int) -> list:
+    rng = np.random.default_rng(seed)
+    cells = shapely.get_parts(
+        shapely.voronoi_polygons(shapely.MultiPoint(rng.random((n, 2))), extend_to=box(0, 0, 1, 1))
+    )
+    return list(shapely.intersection(cells, box(0, 0, 1, 1)))
+
+
+# lists of regions, whose pieces the compiled call classifies by the stages' probes: a
+# tiling; four frames around an uncovered square (a hole no region holds); a region
+# in another's hole; a region of two parts; Voronoi parcels
+FRAME = [box(0, 0, 3, 1), box(2, 1, 3, 3), box(0, 2, 2, 3), box(0, 1, 1, 2)]
+REGION_LISTS = {
+    "tiling": [box(i, j, i + 1, j + 1) for i in range(3) for j in range(2)],
+    "frame": FRAME,
+    "inclusion": [box(0, 0, 4, 4).difference(box(1, 1, 2, 2)), box(1, 1, 2, 2)],
+    "two parts": [MultiPolygon([box(0, 0, 1, 1), box(2, 0, 3, 1)]), box(1, 0, 2, 1)],
+    "voronoi": _voronoi(12, seed=5),
+}
+
+
+@pytest.mark.parametrize("kw", [{}, {"split_boundary": False}, {"min_angle": None}],
+                         ids=["defaults", "whole", "no min angle"])  # fmt: skip
+@pytest.mark.parametrize("name", list(REGION_LISTS))
+def test_common_case_makes_the_stages_mesh_on_lists_of_regions(monkeypatch, checked, name, kw):
+    regions = REGION_LISTS[name]
+    size = 0.05 if name == "voronoi" else 0.3
+    assert _compare(monkeypatch, regions, size, checked, **kw).taken == 1
+    mesh = aftmesh.generate(regions, size, **kw)
+    areas = _region_areas(mesh, range(len(regions)))
+    assert np.allclose(areas, [g.area for g in regions], rtol=1e-9)
+
+
+def test_common_case_takes_lists_of_regions_at_a_size_callable_or_none(monkeypatch, checked):
+    for size in (_graded, None):
+        assert _compare(monkeypatch, REGION_LISTS["tiling"], size, checked).taken == 1
+    # a size per region is the stages' still (a field of the regions' polygons)
+    taken = _compare(monkeypatch, FRAME, [0.2, 0.3, 0.4, 0.5])
+    assert taken.taken == taken.declined == 0
+
+
+def test_common_case_leaves_a_list_of_regions_without_area_to_the_stages(monkeypatch):
+    taken = Taken(monkeypatch)
+    with pytest.raises(InvalidSizeError, match="max_triangles"):
+        aftmesh.generate(REGION_LISTS["tiling"], 0.3, max_triangles=5)
+    assert taken.declined == 1 and taken.taken == 0
 
 
 # islands in lakes in islands, beside a square apart: four parts, each its own region

@@ -25,6 +25,7 @@ from .domain_record import Domain
 from .mesh import Mesh
 from .options import MAX_TRIANGLES, ORDERS, Options
 from .pslg import fractional_markers, markers_out_of_range
+from .regions import classify_pieces
 from .sizing import (
     BOUNDARY_REACH,
     BOX_PAD,
@@ -82,14 +83,15 @@ def applies(dom: Domain, size, opts: Options) -> bool:
     None (the input edges' lengths), or a field (a size callable, or a SizeField) that
     _stages.size_field makes first (see given_field), the compiled subtasks (input
     edges split or kept whole), no progress bar asked for, and one polygon (holes
-    allowed, no constraint lines), polygons whose rings meet nowhere, or a dict or
+    allowed, no constraint lines), polygons of rings whose pieces are classified by
+    how they nest or, as the stages do, by probes (a list of regions), or a dict or
     .poly (Triangle's hole and region points allowed)."""
     return (
         (size is None or _is_plain_number(size) or given_field(size))
         and opts.compiled
         and (opts.progress is None or opts.progress is False)
         and _plain_markers(dom.region_points)
-        and (dom.polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom))
+        and (dom.polygons is None or dom.n_rings == len(dom.source_names))
     )
 
 
@@ -120,6 +122,14 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
     )
 
 
+def _by_probes(dom: Domain) -> bool:
+    """Polygons of rings (no constraint lines) whose pieces neither the exterior ring
+    nor their nesting classifies (a list of regions sharing edges, a multipolygon the
+    kernel did not prove): the compiled call asks classify_pieces about them, as
+    _stages.prepare_front does."""
+    return dom.polygons is not None and not (_one_polygon_of_rings(dom) or _nested_rings(dom))
+
+
 def _nested_rings(dom: Domain) -> bool:
     """Polygons whose rings are all the sources and are proved to meet nowhere: their
     pieces are classified by how they nest (domain.pxi's nested_regions)."""
@@ -147,12 +157,14 @@ def common_case(
     refining = bool(opts.min_angle) and not opts.greedy and opts.swaps
     seeds = dom.region_points if dom.region_points is not None and len(dom.region_points) else None
     cap, _ = opts.triangle_cap
+    by_probes = _by_probes(dom)
     out = generate_common(
         np.ascontiguousarray(dom.vertices, dtype=np.float64),
         np.ascontiguousarray(dom.segments, dtype=np.int32),
         np.ascontiguousarray(dom.segment_edge, dtype=np.int32),
         np.ascontiguousarray(dom.edge_source, dtype=np.int32),
-        dom.polygons is not None and dom.n_rings > 1,  # holes or parts: pieces to classify
+        # holes or parts: pieces to classify (by probes: see below)
+        dom.polygons is not None and dom.n_rings > 1 and not by_probes,
         dom.ring_polygon,
         None if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
         None if seeds is None else _points(seeds[:, :2]),
@@ -177,6 +189,7 @@ def common_case(
         opts.split_boundary,
         given,
         float(expected) if given is not None else -1.0,
+        _classifier(dom.polygons) if by_probes else None,
     )
     if out is None:
         return None
@@ -196,3 +209,13 @@ def common_case(
     )
     timing["total"] = time.perf_counter() - t_start
     return mesh
+
+
+def _classifier(polygons):
+    """generate_common's classify_cb: each piece's region from its probe, as
+    _stages.prepare_front asks regions.classify_pieces."""
+
+    def classify(probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(classify_pieces(polygons, probes, corners), dtype=np.int32)
+
+    return classify
