@@ -337,8 +337,8 @@ def test_common_case_takes_plain_numbers_none_and_fields(monkeypatch):
     assert taken.taken == 1  # the stages' field of the callable, made first
     taken = _compare(monkeypatch, STRIP, None)
     assert taken.taken == 1
-    taken = _compare(monkeypatch, box(0, 0, 1, 1), [0.2])  # per region: the stages
-    assert taken.taken == taken.declined == 0
+    taken = _compare(monkeypatch, box(0, 0, 1, 1), [0.2])  # per region: a field too
+    assert taken.taken == 1
     for bad in (0, 0.0, -1.0, math.inf, math.nan):
         taken = Taken(monkeypatch)
         with pytest.raises(InvalidSizeError, match="finite and positive"):
@@ -449,12 +449,16 @@ def test_common_case_makes_the_stages_mesh_on_lists_of_regions(monkeypatch, chec
     assert np.allclose(areas, [g.area for g in regions], rtol=1e-9)
 
 
-def test_common_case_takes_lists_of_regions_at_a_size_callable_or_none(monkeypatch, checked):
+def test_common_case_takes_lists_of_regions_at_a_size_callable_per_region_or_none(
+    monkeypatch, checked
+):
     for size in (_graded, None):
         assert _compare(monkeypatch, REGION_LISTS["tiling"], size, checked).taken == 1
-    # a size per region is the stages' still (a field of the regions' polygons)
-    taken = _compare(monkeypatch, FRAME, [0.2, 0.3, 0.4, 0.5])
-    assert taken.taken == taken.declined == 0
+    # a size per region: the field of the regions' polygons, made first as a callable's
+    for sizes in ([0.2, 0.3, 0.4, 0.5], (0.2, 0.3, 0.4, 0.5), np.array([0.2, 0.3, 0.4, 0.5])):
+        assert _compare(monkeypatch, FRAME, sizes, checked).taken == 1
+    with pytest.raises(InvalidSizeError):
+        aftmesh.generate(FRAME, [0.2, 0.3])  # one size short: the stages' message
 
 
 def test_common_case_leaves_a_list_of_regions_without_area_to_the_stages(monkeypatch):

@@ -80,7 +80,8 @@ def _is_plain_number(size) -> bool:
 
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size or
-    None (the input edges' lengths), or a field (a size callable, or a SizeField) that
+    None (the input edges' lengths), or a field (a size callable, a SizeField, a size
+    per region) that
     _stages.size_field makes first (see given_field), the compiled subtasks (input
     edges split or kept whole), no progress bar asked for, and one polygon (holes
     allowed, no constraint lines), polygons of rings whose pieces are classified by
@@ -97,10 +98,14 @@ def applies(dom: Domain, size, opts: Options) -> bool:
 
 def given_field(size) -> bool:
     """A size the compiled call takes as the field _stages.size_field makes of it (a
-    callable, the field itself when a SizeField), not as a number: generate builds
-    that field before the call, once, and hands it to the stages if the call
-    declines (the user's callable is not evaluated twice)."""
-    return callable(size)
+    callable, the field itself when a SizeField, a size per region), not as a
+    number: generate builds that field before the call, once, and hands it to the
+    stages if the call declines (the user's callable is not evaluated twice)."""
+    return (
+        callable(size)
+        or isinstance(size, (list, tuple))
+        or (isinstance(size, np.ndarray) and size.ndim == 1)
+    )
 
 
 def _plain_markers(region_points: np.ndarray | None) -> bool:
