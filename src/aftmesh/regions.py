@@ -90,8 +90,12 @@ def _probes_not_inside(probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
     pts = np.ascontiguousarray(np.concatenate([corners.reshape(-1, 2), probes]), dtype=np.float64)
     a = 3 * np.arange(n, dtype=np.int32)
     b, c, p = a + 1, a + 2, np.arange(n, dtype=np.int32) + 3 * n
-    rows = np.concatenate([np.c_[a, b, c], np.c_[a, b, p], np.c_[b, c, p], np.c_[c, a, p]])
-    side = orient2d_many(pts, np.ascontiguousarray(rows, dtype=np.int32)).reshape(4, n)
+    # the triangle (a, b, c), then each edge with the probe: 4 blocks of n rows
+    rows = np.empty((4, n, 3), dtype=np.int32)
+    rows[:, :, 0] = (a, a, b, c)
+    rows[:, :, 1] = (b, b, c, a)
+    rows[:, :, 2] = (c, p, p, p)
+    side = orient2d_many(pts, rows.reshape(4 * n, 3)).reshape(4, n)
     inside = (side[0] != 0) & (side[1] == side[0]) & (side[2] == side[0]) & (side[3] == side[0])
     return np.flatnonzero(~inside)
 
