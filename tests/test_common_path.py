@@ -468,6 +468,42 @@ def test_common_case_leaves_a_list_of_regions_without_area_to_the_stages(monkeyp
     assert taken.declined == 1 and taken.taken == 0
 
 
+# constraint lines and points inside polygons: classified by the stages' probes too
+SQUARE4 = box(0, 0, 4, 4)
+WITH_LINES = {
+    "line inside": [SQUARE4, shapely.LineString([(1, 1), (3, 2.5)])],
+    "line across": [SQUARE4, shapely.LineString([(0, 2), (4, 2)])],
+    "line from the boundary": [SQUARE4, shapely.LineString([(0, 1), (2, 2)])],
+    "polyline": [SQUARE4, shapely.LineString([(0.5, 0.5), (1.5, 3), (3, 1), (3.5, 3.5)])],
+    "points": [SQUARE4, shapely.Point(1, 1), shapely.Point(2.5, 3.1)],
+    "crossing lines": [
+        SQUARE4,
+        shapely.LineString([(1, 1), (3, 3)]),
+        shapely.LineString([(1, 3), (3, 1)]),
+    ],
+    "closed line": [SQUARE4, shapely.LineString([(1, 1), (3, 1), (3, 3), (1, 3), (1, 1)])],
+    "hole and line": [
+        SQUARE4.difference(box(1, 1, 2, 2)),
+        shapely.LineString([(2, 2), (3.5, 3.5)]),
+        shapely.Point(3, 1),
+    ],
+    "parts and line": [
+        MultiPolygon([box(0, 0, 1, 1), box(2, 0, 3, 1)]),
+        shapely.LineString([(0.2, 0.5), (0.8, 0.5)]),
+    ],
+}
+
+
+@pytest.mark.parametrize("split", [True, False], ids=["split", "whole"])
+@pytest.mark.parametrize("size", [0.3, None, _graded], ids=["number", "none", "callable"])
+@pytest.mark.parametrize("name", list(WITH_LINES))
+def test_common_case_makes_the_stages_mesh_with_lines_and_points(
+    monkeypatch, checked, name, size, split
+):
+    collection = shapely.GeometryCollection(WITH_LINES[name])
+    assert _compare(monkeypatch, collection, size, checked, split_boundary=split).taken == 1
+
+
 # islands in lakes in islands, beside a square apart: four parts, each its own region
 LAKES = MultiPolygon(
     [

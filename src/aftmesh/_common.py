@@ -1,12 +1,15 @@
 """generate's common case in one kernel call.
 
-Most calls mesh one polygon (with or without holes, or a dict's rings) at one number
-size, or at the size its edges give (size=None), with the compiled subtasks.  For
-those, the stages of :mod:`aftmesh._stages` from the size field to the refined mesh
-run as one compiled call (``cython_ext/pipeline.pxi``), which applies the stages'
-rules in the same order, so the mesh is the one they make.  Whatever that call does
-not reproduce (a retry for rounding, region classification by probes, a progress
-bar, an error message), it declines, and generate runs the stages instead.
+With the compiled subtasks, whatever the domain (one polygon, with or without
+holes, polygons, a list of regions, constraint lines and points, a dict or .poly) and
+whatever the size (a number, None, a callable, one per region, a SizeField), the
+stages of :mod:`aftmesh._stages` from the size field to the refined mesh run as one
+compiled call (``cython_ext/pipeline.pxi``), which applies the stages' rules in the
+same order, so the mesh is the one they make; the pieces of polygons that the
+exterior ring or their nesting do not classify are classified by the stages' own
+probes, asked from the call.  Whatever that call does not reproduce (a retry for
+rounding, a progress bar, an error message), it declines, and generate runs the
+stages instead.
 """
 
 from __future__ import annotations
@@ -81,18 +84,18 @@ def _is_plain_number(size) -> bool:
 def applies(dom: Domain, size, opts: Options) -> bool:
     """Whether the compiled call may take this generate call: a plain number size or
     None (the input edges' lengths), or a field (a size callable, a SizeField, a size
-    per region) that
-    _stages.size_field makes first (see given_field), the compiled subtasks (input
-    edges split or kept whole), no progress bar asked for, and one polygon (holes
-    allowed, no constraint lines), polygons of rings whose pieces are classified by
-    how they nest or, as the stages do, by probes (a list of regions), or a dict or
-    .poly (Triangle's hole and region points allowed)."""
+    per region) that _stages.size_field makes first (see given_field), the compiled
+    subtasks (input edges split or kept whole), no progress bar asked for, and any
+    domain: one
+    polygon of rings (holes allowed; its pieces told by the exterior ring), a
+    multipolygon proved valid (by how its pieces nest), other polygons (a list of
+    regions, constraint lines and points: by the stages' probes), or a dict or .poly
+    (Triangle's hole and region points allowed)."""
     return (
         (size is None or _is_plain_number(size) or given_field(size))
         and opts.compiled
         and (opts.progress is None or opts.progress is False)
         and _plain_markers(dom.region_points)
-        and (dom.polygons is None or dom.n_rings == len(dom.source_names))
     )
 
 
@@ -128,10 +131,10 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
 
 
 def _by_probes(dom: Domain) -> bool:
-    """Polygons of rings (no constraint lines) whose pieces neither the exterior ring
-    nor their nesting classifies (a list of regions sharing edges, a multipolygon the
-    kernel did not prove): the compiled call asks classify_pieces about them, as
-    _stages.prepare_front does."""
+    """Polygons whose pieces neither the exterior ring nor their nesting classifies
+    (a list of regions sharing edges, a multipolygon the kernel did not prove,
+    constraint lines and points): the compiled call asks classify_pieces about them,
+    as _stages.prepare_front does."""
     return dom.polygons is not None and not (_one_polygon_of_rings(dom) or _nested_rings(dom))
 
 

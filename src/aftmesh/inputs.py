@@ -268,6 +268,13 @@ POLYGON_TYPES = (3, 6)  # Polygon, MultiPolygon
 LINE_TYPES = (1, 2, 5)  # LineString, LinearRing, MultiLineString
 POINT_TYPES = (0, 4)  # Point, MultiPoint
 MULTI_LINE = 5
+# what each shapely type id (+ 1: -1 is a missing geometry; 7 a nested collection)
+# is to a domain: 0 polygons, 1 lines, 2 points, -1 none of them (np.isin costs
+# several microseconds a call)
+_PART_KIND = np.full(9, -1, dtype=np.int8)
+for _kind, _types in enumerate((POLYGON_TYPES, LINE_TYPES, POINT_TYPES)):
+    _PART_KIND[np.array(_types) + 1] = _kind
+del _kind, _types
 
 
 def _split_geometry(domain):
@@ -282,12 +289,13 @@ def _split_geometry(domain):
     else:
         parts = shapely.get_parts(domain)
     kinds = shapely.get_type_id(parts)
-    unknown = np.flatnonzero(~np.isin(kinds, POLYGON_TYPES + LINE_TYPES + POINT_TYPES))
+    part_kind = _PART_KIND[kinds + 1]
+    unknown = np.flatnonzero(part_kind < 0)
     if len(unknown):
         raise InvalidDomainError(f"cannot mesh a {parts[unknown[0]].geom_type}")
-    polygons = list(shapely.get_parts(parts[np.isin(kinds, POLYGON_TYPES)]))
-    points = list(shapely.get_parts(parts[np.isin(kinds, POINT_TYPES)]))
-    is_line = np.isin(kinds, LINE_TYPES)
+    polygons = list(shapely.get_parts(parts[part_kind == 0]))
+    points = list(shapely.get_parts(parts[part_kind == 2]))
+    is_line = part_kind == 1
     lines, owner = shapely.get_parts(parts[is_line], return_index=True)
     count = np.bincount(owner, minlength=int(is_line.sum()))
     start = np.zeros(len(count), dtype=np.int64)
