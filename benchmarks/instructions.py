@@ -4,8 +4,9 @@ valgrind's callgrind: a measure that does not move with the machine's load.
 ``python -m benchmarks.instructions [CASE ...]`` meshes each case (the fixed-cost
 strip ``strip-100``, its other forms ``strip-100/none`` (no size), ``strip-100/x3``
 (three copies as one multipolygon), ``strip-100/dict-hole`` (a Triangle dict with
-a hole point), ``strip-100/whole`` (its input edges kept whole) and
-``strip-100/callable`` (a size callable), and the "small
+a hole point), ``strip-100/whole`` (its input edges kept whole),
+``strip-100/callable`` (a size callable), ``strip-100/regions`` (cut in two
+regions) and ``strip-100/line`` (a constraint line along it), and the "small
 and real" outlines of ``benchmarks.overhead``, by name, or any case of the main
 table, ``square-<h>`` for any h among them, given as that table gives it) in a child
 process under callgrind, twice: once with ``--calls`` counted calls

@@ -214,10 +214,11 @@ def overhead_forms() -> dict[str, tuple[tuple, dict]]:
     """generate's arguments for the fixed-cost strip in the other forms users pass:
     without a size (the edges' sizes), as a multipolygon of three copies side by side,
     as a Triangle dict with a square hole and its hole point, with its input edges
-    kept whole (split_boundary=False, as the main table's aftmesh column meshes), and
-    at a size callable (strip_ramp)."""
+    kept whole (split_boundary=False, as the main table's aftmesh column meshes), at
+    a size callable (strip_ramp), cut in two regions at its middle (a list of two
+    polygons), and with a constraint line along its middle (a GeometryCollection)."""
     from shapely import affinity
-    from shapely.geometry import MultiPolygon
+    from shapely.geometry import GeometryCollection, LineString, MultiPolygon, box
 
     case = overhead_outline()
     poly = case.polygon
@@ -235,12 +236,18 @@ def overhead_forms() -> dict[str, tuple[tuple, dict]]:
         + [[n + i, n + (i + 1) % 4] for i in range(4)],
         "holes": [[cx, cy]],
     }
+    halves = [poly.intersection(box(x0 - 1, y0 - 1, cx, y1 + 1)),
+              poly.intersection(box(cx, y0 - 1, x1 + 1, y1 + 1))]  # fmt: skip
+    # the sides stay within STAR_ROUGHNESS of y = 0 and y = STRIP_WIDTH
+    line = LineString([(x0 + 2.0, 0.5 * STRIP_WIDTH), (x1 - 2.0, 0.5 * STRIP_WIDTH)])
     return {
         f"{case.name}/none": ((poly,), {}),
         f"{case.name}/x3": ((copies, case.size), {}),
         f"{case.name}/dict-hole": ((holed, case.size), {}),
         f"{case.name}/whole": ((poly, case.size), {"split_boundary": False}),
         f"{case.name}/callable": ((poly, strip_ramp), {}),
+        f"{case.name}/regions": ((halves, case.size), {}),
+        f"{case.name}/line": ((GeometryCollection([poly, line]), case.size), {}),
     }
 
 
