@@ -1293,13 +1293,14 @@ def bounding_box(const double[:, ::1] xy):
 def resolve_rounds(Triangulation tri, const double[::1] u, object sample, object rounds_of,
                    int64_t budget, int max_rounds, double tolerance, double span,
                    double coarsest, double thin):
-    """sizing.py's _resolve_callable, every round in one call: the edges of tri not
-    yet sampled, sample(mid) (the callable's checked sizes at their (k, 2) midpoints,
-    one call a round), the midpoints to insert and their insertion in BRIO order
-    (rounds_of(n): the round keys of n points; resolve.pxi), until a round finds nothing to sample or to insert, the
-    samples would pass `budget`, or after max_rounds rounds.  u: the size at each
-    vertex of tri.  Returns (points, u) of every vertex of tri after the rounds.  The
-    GIL is released around each round's kernel steps on a large background."""
+    """sizing.py's _resolve_callable, every round in one call (resolve.pxi): the edges
+    of tri not yet sampled, sample(mid) (the callable's checked sizes at their (k, 2)
+    midpoints, one call a round), the midpoints to insert and their insertion in BRIO
+    order (rounds_of(n): the round keys of n points), until a round finds nothing to
+    sample or to insert, the samples would pass `budget`, or after max_rounds rounds.
+    u: the size at each vertex of tri.  Returns (points, u) of every vertex of tri
+    after the rounds.  The GIL is released around each round's kernel steps on a
+    large background."""
     cdef Tri* T = &tri.T
     cdef Resolve R
     cdef int64_t k, n_keep, calls = 0

@@ -381,8 +381,8 @@ cdef object _mesh_from_pieces(Triangulation tri, const int64_t[::1] rounds,
     """_mesh_pieces on tri (its size field and options set; split: the minimum-angle
     pass may split input segments), with the def layer's error handling: None where
     the stages must run, else (merged vertices, smoothing moves, the refine pass's
-    counts or None, t_cdt, t_aft).  classify_cb (not None: a region list's pieces)
-    gives the region of each piece of the CDT from its probes and corners
+    counts or None, t_cdt, t_aft).  classify_cb (not None: pieces classified by
+    probes) gives the region of each piece of the CDT from its probes and corners
     (Triangulation.components), as _stages.prepare_front does, between the CDT and the
     front."""
     cdef Pieces P
@@ -485,10 +485,11 @@ def generate_common(const double[:, ::1] vertices, const int32_t[:, ::1] segment
     whole; given: a size field _stages.size_field made (a callable's, or a SizeField
     the caller passed), as its kernel_args()[1:], used as it is (constant: its
     constant), else None; given_expected: the triangles it asks for as
-    _stages.size_field counted them (< 0: count here).  classify_cb: for a region
-    list (polygons sharing edges), the region of each piece from its probes and
-    corners (regions.classify_pieces on the polygons), called between the CDT and the
-    front; classify is then off.
+    _stages.size_field counted them (< 0: count here).  classify_cb: for polygons
+    whose pieces neither the exterior ring nor their nesting classifies (a list of
+    regions, constraint lines and points), the region of each piece from its probes
+    and corners (regions.classify_pieces on the polygons), called between the CDT and
+    the front; classify is then off.
     Returns None when the stages must run instead, else (triangulation, source of
     each boundary piece, boundary vertices, merged vertices, the field's arrays or
     None for the constant, expected triangles, smoothing moves, the refine pass's

@@ -1,11 +1,10 @@
 # The rounds of sampling a size callable (src/aftmesh/sizing.py's _resolve_callable),
 # without the call itself: which background edges to sample, and of those whose
-# samples show the background too coarse, which midpoints to insert.  The callable is
-# called once per round between the two (resolve_rounds, _kernel.pyx, calls back into
-# Python for it); every other step of a round is here, so a round costs a few passes
-# over flat arrays instead of some twenty numpy calls.  edges_to_sample and
-# midpoints_to_insert (_kernel.pyx) give one round's two halves to Python on their
-# own.
+# samples show the background too coarse, which midpoints to insert, and their
+# insertion.  The callable is called once per round between the two halves
+# (resolve_rounds, _kernel.pyx, calls back into Python for it); every other step of a
+# round is here, so a round costs a few passes over flat arrays instead of some
+# twenty numpy calls.
 #
 # Edges are int64 keys a n + b (a < b), sorted, as Triangulation.edge_keys gives them.
 #
@@ -200,8 +199,8 @@ cdef int64_t resolve_unsampled(Tri* T, Resolve* R) noexcept nogil:
 
 cdef int64_t resolve_coarse(Resolve* R, int64_t k, const double* mid,
                             const double* um) noexcept nogil:
-    """midpoints_to_insert's verdicts on the k sampled edges: the passed ones merged
-    into R.passed, the midpoints to insert (one per thinning cell) into R.good (its
+    """The verdicts on the k sampled edges (too_coarse): the passed ones merged into
+    R.passed, the midpoints to insert (one per thinning cell) into R.good (its
     passed keys merged by then), in increasing order; returns how many, or an
     error."""
     cdef int64_t i, n_bad = 0, n_good = 0

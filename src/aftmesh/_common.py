@@ -86,11 +86,10 @@ def applies(dom: Domain, size, opts: Options) -> bool:
     None (the input edges' lengths), or a field (a size callable, a SizeField, a size
     per region) that _stages.size_field makes first (see given_field), the compiled
     subtasks (input edges split or kept whole), no progress bar asked for, and any
-    domain: one
-    polygon of rings (holes allowed; its pieces told by the exterior ring), a
-    multipolygon proved valid (by how its pieces nest), other polygons (a list of
-    regions, constraint lines and points: by the stages' probes), or a dict or .poly
-    (Triangle's hole and region points allowed)."""
+    domain: one polygon of rings (holes allowed; its pieces told by the exterior
+    ring), a multipolygon proved valid (by how its pieces nest), other polygons (a
+    list of regions, constraint lines and points: by the stages' probes), or a dict
+    or .poly (Triangle's hole and region points allowed)."""
     return (
         (size is None or _is_plain_number(size) or given_field(size))
         and opts.compiled
