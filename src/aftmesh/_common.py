@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
+from functools import partial
 
 import numpy as np
 from shapely.geometry import Polygon
@@ -129,12 +131,15 @@ def _one_polygon_of_rings(dom: Domain) -> bool:
     )
 
 
-def _by_probes(dom: Domain) -> bool:
-    """Polygons whose pieces neither the exterior ring nor their nesting classifies
-    (a list of regions sharing edges, a multipolygon the kernel did not prove,
-    constraint lines and points): the compiled call asks classify_pieces about them,
-    as _stages.prepare_front does."""
-    return dom.polygons is not None and not (_one_polygon_of_rings(dom) or _nested_rings(dom))
+def _by_probes(dom: Domain) -> Callable | None:
+    """generate_common's classify_cb for polygons whose pieces neither the exterior
+    ring nor their nesting classifies (a list of regions sharing edges, a multipolygon
+    the kernel did not prove, constraint lines and points): each piece's region from
+    its probe, as _stages.prepare_front asks regions.classify_pieces; else None."""
+    polygons = dom.polygons
+    if polygons is None or _one_polygon_of_rings(dom) or _nested_rings(dom):
+        return None
+    return partial(classify_pieces, polygons)
 
 
 def _nested_rings(dom: Domain) -> bool:
@@ -171,7 +176,7 @@ def common_case(
         np.ascontiguousarray(dom.segment_edge, dtype=np.int32),
         np.ascontiguousarray(dom.edge_source, dtype=np.int32),
         # holes or parts: pieces to classify (by probes: see below)
-        dom.polygons is not None and dom.n_rings > 1 and not by_probes,
+        dom.polygons is not None and dom.n_rings > 1 and by_probes is None,
         dom.ring_polygon,
         None if dom.holes is None or len(dom.holes) == 0 else _points(dom.holes),
         None if seeds is None else _points(seeds[:, :2]),
@@ -196,7 +201,7 @@ def common_case(
         opts.split_boundary,
         given,
         float(expected) if given is not None else -1.0,
-        _classifier(dom.polygons) if by_probes else None,
+        by_probes,
     )
     if out is None:
         return None
@@ -216,13 +221,3 @@ def common_case(
     )
     timing["total"] = time.perf_counter() - t_start
     return mesh
-
-
-def _classifier(polygons):
-    """generate_common's classify_cb: each piece's region from its probe, as
-    _stages.prepare_front asks regions.classify_pieces."""
-
-    def classify(probes: np.ndarray, corners: np.ndarray) -> np.ndarray:
-        return np.ascontiguousarray(classify_pieces(polygons, probes, corners), dtype=np.int32)
-
-    return classify
