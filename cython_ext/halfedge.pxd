@@ -106,11 +106,17 @@ cdef enum:
 # the sign's correction: these run in every rotation and walk.  tri_of stands for
 # `e // 3` in the hottest tests (the meshed-edge and ring tests); in flip, the Lawson
 # loops and locate it made the compiled kernel run more instructions, not fewer.
+# nxt and prv take their offset (+1 / -2, +2 / -1) from a constant table of 2-bit
+# fields, shifted by e % 3, rather than choosing it: e % 3 is as good as random in
+# the rotations around a vertex and the walks, and gcc compiled the choice (written as
+# a conditional or as arithmetic on the comparison) to a branch that callgrind's
+# branch simulation found mispredicted about one time in three, a few percent of the
+# meshing time on graded meshes.  The shifts have no branch.
 cdef inline int nxt(int e) noexcept nogil:
-    return e - 2 if <uint32_t> e % 3 == 2 else e + 1
+    return e + <int> ((0x0F >> (2 * (<uint32_t> e % 3))) & 3) - 2
 
 cdef inline int prv(int e) noexcept nogil:
-    return e + 2 if <uint32_t> e % 3 == 0 else e - 1
+    return e + <int> ((0x03 >> (2 * (<uint32_t> e % 3))) & 3) - 1
 
 cdef inline int tri_of(int e) noexcept nogil:
     return <int> (<uint32_t> e // 3)
