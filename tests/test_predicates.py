@@ -461,6 +461,29 @@ def test_incircle_exactly_cocircular_integers(pts, ox, oy, e):
     assert check_incircle(*moved) == 0
 
 
+_RECT_COORD = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False).filter(
+    lambda v: in_range([v], INCIRCLE_EXP)
+)
+
+
+@PROFILE
+@given(_RECT_COORD, _RECT_COORD, _RECT_COORD, _RECT_COORD, st.integers(0, 3), st.integers(-2, 2))
+def test_incircle_axis_rectangles_and_their_neighbours(x0, x1, y0, y1, moved, ulps):
+    # The corners of an axis-parallel rectangle (incircle's shortcut answers 0 for
+    # them without the adaptive stage), every order checked by check_incircle; with
+    # one corner moved by a few ulps along x the shortcut must not apply: the four
+    # points are cocircular again only where the move lands on a corner's x (no move,
+    # or onto the other corner of that side, a repeated point).
+    assume(x0 != x1 and y0 != y1)
+    corners = [(x0, y0), (x1, y0), (x1, y1), (x0, y1)]
+    assert check_incircle(*corners) == 0
+    x, y = corners[moved]
+    corners[moved] = (nudge(x, ulps), y)
+    assume(in_range(corners[moved], INCIRCLE_EXP))  # not 0 moved to a subnormal
+    expected = check_incircle(*corners)
+    assert (expected == 0) == (corners[moved][0] in (x0, x1))
+
+
 def test_cocircular_and_collinear_examples():
     assert py_incircle(5, 0, 0, 5, -5, 0, 3, 4) == 0
     assert py_incircle(5, 0, 0, 5, -5, 0, 3, 3.99) == 1
