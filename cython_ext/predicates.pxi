@@ -742,7 +742,7 @@ cdef inline int _pred_incircle_filter(const double* a, const double* b, const do
 
 
 cdef bint _pred_axis_rectangle(const double* a, const double* b, const double* c,
-                              const double* d) noexcept nogil:
+                               const double* d) noexcept nogil:
     """The four points are the corners of an axis-parallel rectangle, in any order:
     cocircular, so incircle is exactly 0.  Input split evenly along parallel walls (a
     channel, a comb's teeth, a rectangle's sides) gives these by the thousand, and the
