@@ -34,8 +34,8 @@ cdef int _first_crossing(Tri* T, int a, int b, int* out) noexcept nogil:
     cdef int e0 = T.vhe[a]
     cdef int e = e0, x, y, ox, oy, guard = 0
     while True:
-        x = T.tv[nxt(e)]
-        y = T.tv[prv(e)]
+        x = T.tv[nxt_nb(e)]
+        y = T.tv[prv_nb(e)]
         if x != GHOST:
             ox = orient2d(P(T, a), P(T, b), P(T, x))
             if ox == 0 and _on_ray(T, a, b, x):
@@ -44,9 +44,9 @@ cdef int _first_crossing(Tri* T, int a, int b, int* out) noexcept nogil:
             if y != GHOST and ox < 0:
                 oy = orient2d(P(T, a), P(T, b), P(T, y))
                 if oy > 0:
-                    out[0] = nxt(e)
+                    out[0] = nxt_nb(e)
                     return 0
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0 or guard > 3 * T.nt + 3:
             return ERR_INTERNAL
@@ -167,20 +167,20 @@ cdef int _walk_cavity(Tri* T, int a, int b, int h, int m, int* out) noexcept nog
     lch[0] = a
     rch[0] = a
     rch[1] = T.tv[h]
-    rorig[0] = prv(h)
-    lch[1] = T.tv[nxt(h)]
-    lorig[0] = nxt(h)
+    rorig[0] = prv_nb(h)
+    lch[1] = T.tv[nxt_nb(h)]
+    lorig[0] = nxt_nb(h)
     tris[0] = h // 3
     while ntri < m - 1 and nl < m - 1 and nr < m - 1:
         if blocking(T, h):
             T.err_a = a
             T.err_b = b
             T.err_u = T.tv[h]
-            T.err_v = T.tv[nxt(h)]
+            T.err_v = T.tv[nxt_nb(h)]
             T.err_seg = T.eseg[h]
             return ERR_CROSSING
         g = T.twin[h]
-        w = T.tv[prv(g)]
+        w = T.tv[prv_nb(g)]
         if w == GHOST:
             return ERR_INTERNAL
         tris[ntri] = g // 3
@@ -188,14 +188,14 @@ cdef int _walk_cavity(Tri* T, int a, int b, int h, int m, int* out) noexcept nog
         ow = 0 if w == b else orient2d(P(T, a), P(T, b), P(T, w))
         if ow >= 0:
             lch[nl] = w
-            lorig[nl - 1] = prv(g)
+            lorig[nl - 1] = prv_nb(g)
             nl += 1
-            h = nxt(g)
+            h = nxt_nb(g)
         if ow <= 0:
             rch[nr] = w
-            rorig[nr - 1] = nxt(g)
+            rorig[nr - 1] = nxt_nb(g)
             nr += 1
-            h = prv(g)
+            h = prv_nb(g)
         if ow == 0:
             out[0] = ntri
             out[1] = nl

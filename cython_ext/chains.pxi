@@ -53,33 +53,33 @@ cdef int chain_ends(Tri* T, int n_corner, int32_t* vend) noexcept nogil:
             continue
         # walk from the chain end u along e to the other end; then mark the inside
         prev = u
-        w = T.tv[nxt(e)]
+        w = T.tv[nxt_nb(e)]
         n = 0
         while w >= n_corner and deg[w] == 2 and n <= T.nv:
             f = T.vhe[w]
             guard = 0
-            while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt(f)] == prev:
-                f = T.twin[prv(f)]
+            while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt_nb(f)] == prev:
+                f = T.twin[prv_nb(f)]
                 guard += 1
                 if guard > ROTATION_CAP:
                     free(deg)
                     free(seg)
                     return ERR_INTERNAL
-            nxtv = T.tv[nxt(f)]
+            nxtv = T.tv[nxt_nb(f)]
             vend[2 * w] = u
             prev = w
             w = nxtv
             n += 1
         # second pass: the far end is w; write it on the same vertices
         prev = u
-        nxtv = T.tv[nxt(e)]
+        nxtv = T.tv[nxt_nb(e)]
         while nxtv != w:
             vend[2 * nxtv + 1] = w
             f = T.vhe[nxtv]
-            while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt(f)] == prev:
-                f = T.twin[prv(f)]
+            while not (T.eflag[f] & E_SEGMENT) or T.tv[nxt_nb(f)] == prev:
+                f = T.twin[prv_nb(f)]
             prev = nxtv
-            nxtv = T.tv[nxt(f)]
+            nxtv = T.tv[nxt_nb(f)]
     free(deg)
     free(seg)
     return 0

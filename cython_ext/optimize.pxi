@@ -141,8 +141,8 @@ cdef int _gather_ring(Tri* T, int v, int e0, Ring* R, double* q) noexcept nogil:
     cdef double* pw
     cdef double* pv = P(T, v)
     while True:
-        u = T.tv[nxt(e)]
-        w = T.tv[prv(e)]
+        u = T.tv[nxt_nb(e)]
+        w = T.tv[prv_nb(e)]
         if u < 0 or w < 0 or T.tstate[tri_of(e)] != T_MESHED or n >= OPT_RING_CAP:
             return 0
         pu = P(T, u)
@@ -153,7 +153,7 @@ cdef int _gather_ring(Tri* T, int v, int e0, Ring* R, double* q) noexcept nogil:
         R.oy2[n] = (pw[1] - pu[1]) * (pw[1] - pu[1])
         q[n] = _shape(pv, pu, pw)
         n += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             break
     R.n = n
@@ -305,9 +305,9 @@ cdef bint _ring_ccw(Tri* T, int v) noexcept nogil:
     exact orient2d: the test a trial place must pass once the float cost took it."""
     cdef int e0 = T.vhe[v], e = e0
     while True:
-        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), P(T, T.tv[prv(e)])) <= 0:
+        if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), P(T, T.tv[prv_nb(e)])) <= 0:
             return False
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             return True
 
@@ -324,9 +324,9 @@ cdef int _legalize_around(Tri* T, int v) noexcept nogil:
         # the spoke leaving v and the edge opposite v: each spoke is also the edge
         # entering v of the triangle before, so it is pushed once
         T.stack[n] = e
-        T.stack[n + 1] = nxt(e)
+        T.stack[n + 1] = nxt_nb(e)
         n += 2
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0 or n >= 2 * OPT_RING_CAP:
             break
     res = legalize_meshed(T, n)
@@ -356,9 +356,9 @@ cdef bint _ring_needs_flips(Tri* T, int v) noexcept nogil:
     while True:
         meshed = T.tstate[tri_of(e)] == T_MESHED
         if meshed:
-            pu = P(T, T.tv[nxt(e)])
-            pw = P(T, T.tv[prv(e)])
-            if _opposite_illegal(T, nxt(e), pu, pw, pv):
+            pu = P(T, T.tv[nxt_nb(e)])
+            pw = P(T, T.tv[prv_nb(e)])
+            if _opposite_illegal(T, nxt_nb(e), pu, pw, pv):
                 return True
             if e == e0:
                 pu0 = pu
@@ -369,7 +369,7 @@ cdef bint _ring_needs_flips(Tri* T, int v) noexcept nogil:
             at_u_prev = surely_acute(pw, pv, pu)
             pu_prev = pu
         meshed_prev = meshed
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             break
     # e0's spoke: its other triangle is the walk's last
@@ -397,7 +397,7 @@ cdef inline bint _opposite_illegal(Tri* T, int o, const double* pu, const double
     cdef const double* pd
     if T.tstate[tri_of(f)] != T_MESHED or T.eflag[o] & (E_SEGMENT | E_FIXED):
         return False
-    pd = P(T, T.tv[prv(f)])
+    pd = P(T, T.tv[prv_nb(f)])
     if surely_acute(pu, pw, pv) and surely_acute(pw, pu, pd):
         return False
     return incircle(pu, pw, pv, pd) > 0

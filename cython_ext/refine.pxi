@@ -281,7 +281,7 @@ cdef int _push_star(Refine* R, Tri* T, int v) noexcept nogil:
     while True:
         if _push_tri(R, T, e // 3):
             return ERR_NOMEM
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0:
             return 0
@@ -304,20 +304,20 @@ cdef int _queue_encroached_near(Refine* R, Tri* T, int v) noexcept nogil:
     cdef int e0 = T.vhe[v], e = e0, f, g, guard = 0, k
     while True:
         if T.tstate[e // 3] == T_MESHED and not _below_resolution(R, T, e // 3):
-            f = nxt(e)                  # the edge of v's triangle opposite v
+            f = nxt_nb(e)                  # the edge of v's triangle opposite v
             if (T.eflag[f] & E_SEGMENT) and _encroaches(
-                    P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt(f)])) and not _across_apex(
-                    R, T, v, T.tv[f], T.tv[nxt(f)]):
-                if _push_seg(R, T.tv[f], T.tv[nxt(f)]):
+                    P(T, v), P(T, T.tv[f]), P(T, T.tv[nxt_nb(f)])) and not _across_apex(
+                    R, T, v, T.tv[f], T.tv[nxt_nb(f)]):
+                if _push_seg(R, T.tv[f], T.tv[nxt_nb(f)]):
                     return ERR_NOMEM
             for k in range(2):
-                g = e if k == 0 else prv(e)     # the two edges of this triangle at v
+                g = e if k == 0 else prv_nb(e)     # the two edges of this triangle at v
                 if (T.eflag[g] & E_SEGMENT) and _encroaches(
-                        P(T, T.tv[prv(g)]), P(T, T.tv[g]), P(T, T.tv[nxt(g)])) and not \
-                        _across_apex(R, T, T.tv[prv(g)], T.tv[g], T.tv[nxt(g)]):
-                    if _push_seg(R, T.tv[g], T.tv[nxt(g)]):
+                        P(T, T.tv[prv_nb(g)]), P(T, T.tv[g]), P(T, T.tv[nxt_nb(g)])) and not \
+                        _across_apex(R, T, T.tv[prv_nb(g)], T.tv[g], T.tv[nxt_nb(g)]):
+                    if _push_seg(R, T.tv[g], T.tv[nxt_nb(g)]):
                         return ERR_NOMEM
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0:
             return 0
@@ -349,14 +349,14 @@ cdef int _chains_of(Refine* R, Tri* T, int p, int32_t* out, int cap) noexcept no
     e = e0
     while n < cap:
         if T.eflag[e] & E_SEGMENT:
-            w = T.tv[nxt(e)]
+            w = T.tv[nxt_nb(e)]
             other = w
             if R.vend[2 * w] >= 0:
                 other = R.vend[2 * w + 1] if R.vend[2 * w] == p else R.vend[2 * w]
             out[2 * n] = p
             out[2 * n + 1] = other
             n += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0 or guard > ROTATION_CAP:
             break
@@ -373,7 +373,7 @@ cdef bint _excepted(Refine* R, Tri* T, int e) noexcept nogil:
     sees p and q at an angle below the bound."""
     cdef int32_t cp[32]
     cdef int32_t cq[32]
-    cdef int p = T.tv[e], q = T.tv[nxt(e)], np_, nq, i, j, k, m, a
+    cdef int p = T.tv[e], q = T.tv[nxt_nb(e)], np_, nq, i, j, k, m, a
     np_ = _chains_of(R, T, p, cp, 16)
     if np_ == 0:
         return False
@@ -427,7 +427,7 @@ cdef bint _small_apex(Refine* R, Tri* T, int a, const double* toward, int32_t ca
     if e0 < 0:
         return False
     while True:
-        w = T.tv[nxt(e)]
+        w = T.tv[nxt_nb(e)]
         if (T.eflag[e] & E_SEGMENT) and w >= 0 and w != ca and w != cb and not (
                 (R.vend[2 * w] == ca and R.vend[2 * w + 1] == cb)
                 or (R.vend[2 * w] == cb and R.vend[2 * w + 1] == ca)):
@@ -437,7 +437,7 @@ cdef bint _small_apex(Refine* R, Tri* T, int a, const double* toward, int32_t ca
             if dot > 0 and dot * dot > SHELL_COS * SHELL_COS * (ux * ux + uy * uy) * (
                     vx * vx + vy * vy):
                 return True
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0 or guard > ROTATION_CAP:
             return False
@@ -535,7 +535,7 @@ cdef bint _split_is_valid(Tri* T, int e, const double* m) noexcept nogil:
     """Putting a vertex at m on the edge of e keeps the four new triangles
     counter-clockwise (m is off the segment by up to an ulp)."""
     cdef int f = T.twin[e]
-    cdef int a = T.tv[e], b = T.tv[nxt(e)], c = T.tv[prv(e)], d = T.tv[prv(f)]
+    cdef int a = T.tv[e], b = T.tv[nxt_nb(e)], c = T.tv[prv_nb(e)], d = T.tv[prv_nb(f)]
     if c >= 0 and (orient2d(P(T, b), P(T, c), m) <= 0 or orient2d(P(T, c), P(T, a), m) <= 0):
         return False
     if d >= 0 and (orient2d(P(T, a), P(T, d), m) <= 0 or orient2d(P(T, d), P(T, b), m) <= 0):
@@ -555,7 +555,7 @@ cdef bint _valid_split_near(Tri* T, int e, double* m) noexcept nogil:
     """Accept m, or move it by up to SPLIT_NUDGE_ULPS to either side of e's edge: a
     point an ulp off a segment can invert a sliver of triangle next to it."""
     cdef double* a = P(T, T.tv[e])
-    cdef double* b = P(T, T.tv[nxt(e)])
+    cdef double* b = P(T, T.tv[nxt_nb(e)])
     cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h
     cdef double x0 = m[0], y0 = m[1]
     cdef int k
@@ -593,8 +593,8 @@ cdef bint _inward_point(Refine* R, Tri* T, int f, int u, int w, double* m) noexc
     (its edge u-w): the shell point, the midpoint or another point of the middle half,
     moved by up to SPLIT_NUDGE_ULPS into the domain."""
     cdef double* a = P(T, T.tv[f])
-    cdef double* b = P(T, T.tv[nxt(f)])
-    cdef double* c = P(T, T.tv[prv(f)])
+    cdef double* b = P(T, T.tv[nxt_nb(f)])
+    cdef double* c = P(T, T.tv[prv_nb(f)])
     cdef double nx = a[1] - b[1], ny = b[0] - a[0], L = sqrt(nx * nx + ny * ny), h, x0, y0, t
     cdef int k, j
     for j in range(SPLIT_TRIES):
@@ -621,7 +621,7 @@ cdef int _split_inward(Tri* T, int f, int v) noexcept nogil:
     the exterior and move the segment's flags from a-b to a-v and v-b.  The domain
     loses the sliver (about an ulp times the edge's length).  Returns how many edges
     facing v on the meshed side are on T.stack for the Lawson flips."""
-    cdef int a = T.tv[f], b = T.tv[nxt(f)], n, h, s, x, i, k = 0
+    cdef int a = T.tv[f], b = T.tv[nxt_nb(f)], n, h, s, x, i, k = 0
     cdef uint8_t g
     cdef int32_t sid
     n = split_triangle(T, f // 3, v)
@@ -640,7 +640,7 @@ cdef int _split_inward(Tri* T, int f, int v) noexcept nogil:
     T.eseg[h] = -1
     T.eseg[T.twin[h]] = -1
     for i in range(2):
-        x = nxt(h) if i == 0 else prv(h)
+        x = nxt_nb(h) if i == 0 else prv_nb(h)
         T.eflag[x] = g
         T.eflag[T.twin[x]] = g
         T.eseg[x] = sid
@@ -668,10 +668,10 @@ cdef int _legalize_split(Refine* R, Tri* T, int v) noexcept nogil:
             if reserve_stack(T, n + 3):
                 return ERR_NOMEM
             T.stack[n] = e
-            T.stack[n + 1] = nxt(e)
-            T.stack[n + 2] = prv(e)
+            T.stack[n + 1] = nxt_nb(e)
+            T.stack[n + 2] = prv_nb(e)
             n += 3
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0:
             break
@@ -744,8 +744,8 @@ cdef void _candidate(Refine* R, Tri* T, int e, double* M, double* X) noexcept no
     bisector of p-q on r's side, at the circumcentre or nearer (where the triangle on
     p-q would have an apex angle just above the bound), whichever is nearer."""
     cdef double* p = P(T, T.tv[e])
-    cdef double* q = P(T, T.tv[nxt(e)])
-    cdef double* r = P(T, T.tv[prv(e)])
+    cdef double* q = P(T, T.tv[nxt_nb(e)])
+    cdef double* r = P(T, T.tv[prv_nb(e)])
     cdef double ex = q[0] - p[0], ey = q[1] - p[1], L = sqrt(ex * ex + ey * ey)
     cdef double ux = p[0] - r[0], uy = p[1] - r[1], vx = q[0] - r[0], vy = q[1] - r[1]
     cdef double cross = ux * vy - uy * vx, dot = ux * vx + uy * vy
@@ -765,13 +765,13 @@ cdef int _walk(Tri* T, int e, const double* M, const double* X, int* where) noex
     where = the constrained half-edge met first (X lies across it or on it); or
     WALK_FAILED (X at a vertex, the line through a vertex, a broken structure)."""
     cdef int g = e, u, v, w, o1, o2, ow, exit_e, steps = 0
-    if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), X) <= 0:
+    if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), X) <= 0:
         return WALK_FAILED
     while steps <= T.nt:
         steps += 1
         u = T.tv[g]
-        v = T.tv[nxt(g)]
-        w = T.tv[prv(g)]
+        v = T.tv[nxt_nb(g)]
+        w = T.tv[prv_nb(g)]
         if w < 0:
             return WALK_FAILED
         o1 = orient2d(P(T, v), P(T, w), X)
@@ -779,7 +779,7 @@ cdef int _walk(Tri* T, int e, const double* M, const double* X, int* where) noex
         if o1 >= 0 and o2 >= 0:
             if o1 == 0 and o2 == 0:
                 return WALK_FAILED
-            exit_e = nxt(g) if o1 == 0 else (prv(g) if o2 == 0 else NONE)
+            exit_e = nxt_nb(g) if o1 == 0 else (prv_nb(g) if o2 == 0 else NONE)
             if exit_e == NONE:
                 where[0] = g // 3
                 return WALK_FOUND
@@ -791,7 +791,7 @@ cdef int _walk(Tri* T, int e, const double* M, const double* X, int* where) noex
         ow = orient2d(M, X, P(T, w))
         if ow == 0:
             return WALK_FAILED
-        exit_e = nxt(g) if ow > 0 else prv(g)
+        exit_e = nxt_nb(g) if ow > 0 else prv_nb(g)
         if blocking(T, exit_e):
             where[0] = exit_e
             return WALK_BLOCKED
@@ -815,7 +815,7 @@ cdef inline bint _harmful(Refine* R, Tri* T, int h, const double* X) noexcept no
     inserting there could make the mesh worse: X is then inserted only if every
     triangle it makes (X and an edge h of the cavity's boundary) meets the bound, so
     the worst angle never gets smaller."""
-    return not R.split_segments and _points_bad(R, P(T, T.tv[h]), P(T, T.tv[nxt(h)]), X)
+    return not R.split_segments and _points_bad(R, P(T, T.tv[h]), P(T, T.tv[nxt_nb(h)]), X)
 
 
 cdef int _encroached_by(Refine* R, Tri* T, const double* X, int t0, int t1) noexcept nogil:
@@ -837,11 +837,11 @@ cdef int _encroached_by(Refine* R, Tri* T, const double* X, int t0, int t1) noex
         for k in range(3):
             h = 3 * R.cav[i] + k
             if blocking(T, h):
-                if _encroaches(X, P(T, T.tv[h]), P(T, T.tv[nxt(h)])) or _harmful(R, T, h, X):
+                if _encroaches(X, P(T, T.tv[h]), P(T, T.tv[nxt_nb(h)])) or _harmful(R, T, h, X):
                     if _grow_i32(&R.enc, &R.enc_cap, 2 * R.enc_n + 2):
                         return ERR_NOMEM
                     R.enc[2 * R.enc_n] = T.tv[h]
-                    R.enc[2 * R.enc_n + 1] = T.tv[nxt(h)]
+                    R.enc[2 * R.enc_n + 1] = T.tv[nxt_nb(h)]
                     R.enc_n += 1
                 continue
             nb = T.twin[h] // 3
@@ -883,7 +883,7 @@ cdef int _refine_triangle(Refine* R, Aft* A, Tri* T, int t, int e) noexcept nogi
         if not (T.eflag[where] & E_SEGMENT):
             return ACT_DROPPED
         seg[0] = T.tv[where]
-        seg[1] = T.tv[nxt(where)]
+        seg[1] = T.tv[nxt_nb(where)]
         return _split_all(R, A, T, seg, 1)
     loc = LOC_IN_TRIANGLE
     if where >= 3 * T.nt:

@@ -44,14 +44,14 @@ cdef int _fan_start(Tri* T, int v) noexcept nogil:
     if e0 < 0:
         return NONE
     while True:
-        if T.tv[nxt(e)] == GHOST or T.tv[prv(e)] == GHOST or n >= OPT_RING_CAP:
+        if T.tv[nxt_nb(e)] == GHOST or T.tv[prv_nb(e)] == GHOST or n >= OPT_RING_CAP:
             return NONE
         if T.eflag[e] & E_SEGMENT:
             pieces += 1
             if T.tstate[e // 3] == T_MESHED:
                 s = e
         n += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             break
     return s if pieces == 2 else NONE
@@ -69,8 +69,8 @@ cdef int _gather_fan(Tri* T, int v, int s, Ring* R, double* q) noexcept nogil:
     while True:
         if T.tstate[e // 3] != T_MESHED:
             return 0
-        u = T.tv[nxt(e)]
-        w = T.tv[prv(e)]
+        u = T.tv[nxt_nb(e)]
+        w = T.tv[prv_nb(e)]
         pu = P(T, u)
         pw = P(T, w)
         R.x[n] = pu[0]
@@ -79,12 +79,12 @@ cdef int _gather_fan(Tri* T, int v, int s, Ring* R, double* q) noexcept nogil:
         R.oy2[n] = (pw[1] - pu[1]) * (pw[1] - pu[1])
         q[n] = _shape(pv, pu, pw)
         n += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == s or ((T.eflag[e] & E_SEGMENT) and T.tstate[e // 3] != T_MESHED):
             break
     R.n = n
-    R.x[n] = P(T, T.tv[nxt(e)])[0]
-    R.y[n] = P(T, T.tv[nxt(e)])[1]
+    R.x[n] = P(T, T.tv[nxt_nb(e)])[0]
+    R.y[n] = P(T, T.tv[nxt_nb(e)])[1]
     return n
 
 

@@ -245,10 +245,10 @@ cdef void _mark_ring(Tri* T, int v) noexcept nogil:
     if e0 < 0:
         return
     while True:
-        u = T.tv[nxt(e)]
+        u = T.tv[nxt_nb(e)]
         if u >= 0:
             dirty[u] = V_CHANGED
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0 or e < 0:
             return
 

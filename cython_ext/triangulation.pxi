@@ -211,7 +211,7 @@ cdef void flip(Tri* T, int e) noexcept nogil:
     cdef int t0 = e // 3
     cdef int f = T.twin[e]
     cdef int t1 = f // 3
-    cdef int e1 = nxt(e), e2 = prv(e), f1 = nxt(f), f2 = prv(f)
+    cdef int e1 = nxt_nb(e), e2 = prv_nb(e), f1 = nxt_nb(f), f2 = prv_nb(f)
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
@@ -291,9 +291,9 @@ cdef int lawson_after_insert(Tri* T, int nstack) noexcept nogil:
             continue
         f = T.twin[e]
         a = T.tv[e]
-        b = T.tv[nxt(e)]
-        p = T.tv[prv(e)]
-        d = T.tv[prv(f)]
+        b = T.tv[nxt_nb(e)]
+        p = T.tv[prv_nb(e)]
+        d = T.tv[prv_nb(f)]
         if in_circle_ext(T, a, b, p, d):
             t0 = e // 3
             t1 = f // 3
@@ -322,9 +322,9 @@ cdef inline bint illegal_meshed_edge(Tri* T, int e) noexcept nogil:
     if T.eflag[e] & (E_SEGMENT | E_FIXED):
         return False
     pa = P(T, T.tv[e])
-    pb = P(T, T.tv[nxt(e)])
-    pc = P(T, T.tv[prv(e)])
-    pd = P(T, T.tv[prv(f)])
+    pb = P(T, T.tv[nxt_nb(e)])
+    pc = P(T, T.tv[prv_nb(e)])
+    pd = P(T, T.tv[prv_nb(f)])
     if surely_acute(pa, pb, pc) and surely_acute(pb, pa, pd):
         return False
     return incircle(pa, pb, pc, pd) > 0
@@ -355,9 +355,9 @@ cdef int legalize_meshed_with(Tri* T, int nstack, flip_hook hook, void* ctx) noe
             t1 = f // 3
             if T.vdirty != NULL:
                 T.vdirty[T.tv[e]] = V_CHANGED
-                T.vdirty[T.tv[nxt(e)]] = V_CHANGED
-                T.vdirty[T.tv[prv(e)]] = V_CHANGED
-                T.vdirty[T.tv[prv(f)]] = V_CHANGED
+                T.vdirty[T.tv[nxt_nb(e)]] = V_CHANGED
+                T.vdirty[T.tv[prv_nb(e)]] = V_CHANGED
+                T.vdirty[T.tv[prv_nb(f)]] = V_CHANGED
             flip(T, e)
             if hook != NULL:
                 res = hook(ctx, T, t0)
@@ -417,7 +417,7 @@ cdef int locate_scan(Tri* T, const double* p, int* where) noexcept nogil:
             continue
         for k in range(3):
             e = 3 * t + k
-            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p)
+            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), p)
             if o3[k] < 0:
                 break
         else:
@@ -427,8 +427,8 @@ cdef int locate_scan(Tri* T, const double* p, int* where) noexcept nogil:
             continue
         for k in range(3):
             e = 3 * t + k
-            if T.tv[e] != GHOST and T.tv[nxt(e)] != GHOST:
-                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p) > 0:
+            if T.tv[e] != GHOST and T.tv[nxt_nb(e)] != GHOST:
+                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), p) > 0:
                     where[0] = t
                     return LOC_OUTSIDE
     return ERR_INTERNAL
@@ -454,8 +454,8 @@ cdef int locate(Tri* T, const double* p, int start, int* where) noexcept nogil:
         # step into the finite triangle behind the ghost's finite edge
         for k in range(3):
             e = 3 * t + k
-            if T.tv[e] != GHOST and T.tv[nxt(e)] != GHOST:
-                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p) > 0:
+            if T.tv[e] != GHOST and T.tv[nxt_nb(e)] != GHOST:
+                if orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), p) > 0:
                     where[0] = t
                     return LOC_OUTSIDE
                 t = T.twin[e] // 3
@@ -466,7 +466,7 @@ cdef int locate(Tri* T, const double* p, int start, int* where) noexcept nogil:
         for i in range(3):
             k = (r + i) % 3
             e = 3 * t + k
-            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt(e)]), p)
+            o3[k] = orient2d(P(T, T.tv[e]), P(T, T.tv[nxt_nb(e)]), p)
             if o3[k] < 0:
                 t = T.twin[e] // 3
                 if is_ghost(T, t):
@@ -517,7 +517,7 @@ cdef int split_edge(Tri* T, int e, int v) noexcept nogil:
     a segment).  Pushes the four edges opposite v; returns the stack size."""
     cdef int f = T.twin[e]
     cdef int t0 = e // 3, t1 = f // 3
-    cdef int e1 = nxt(e), e2 = prv(e), f1 = nxt(f), f2 = prv(f)
+    cdef int e1 = nxt_nb(e), e2 = prv_nb(e), f1 = nxt_nb(f), f2 = prv_nb(f)
     cdef int a = T.tv[e], b = T.tv[e1], c = T.tv[e2], d = T.tv[f2]
     cdef int te1 = T.twin[e1], te2 = T.twin[e2], tf1 = T.twin[f1], tf2 = T.twin[f2]
     cdef uint8_t ge1 = T.eflag[e1], ge2 = T.eflag[e2], gf1 = T.eflag[f1], gf2 = T.eflag[f2]
@@ -610,9 +610,9 @@ cdef int find_edge(Tri* T, int a, int b) noexcept nogil:
     if e0 < 0:
         return NONE
     while True:
-        if T.tv[nxt(e)] == b:
+        if T.tv[nxt_nb(e)] == b:
             return e
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         guard += 1
         if e == e0 or guard > T.nt * 3 + 3:
             return NONE

@@ -98,9 +98,9 @@ cdef int valence_flips(Tri* T, int first_movable, uint8_t* touched) noexcept nog
         if T.eflag[e] & (E_SEGMENT | E_FIXED):
             continue
         a = T.tv[e]
-        b = T.tv[nxt(e)]
-        c = T.tv[prv(e)]
-        d = T.tv[prv(f)]
+        b = T.tv[nxt_nb(e)]
+        c = T.tv[prv_nb(e)]
+        d = T.tv[prv_nb(f)]
         if a < first_movable and b < first_movable and c < first_movable and d < first_movable:
             continue            # none of them moves: the Delaunay swaps would undo it
         if not _flip_helps(x, a, b, c, d):
@@ -164,7 +164,7 @@ cdef int _valence_split_point(Tri* T, int v, double* p) noexcept nogil:
     if e0 < 0:
         return -1
     while True:
-        u = T.tv[nxt(e)]
+        u = T.tv[nxt_nb(e)]
         if u < 0 or T.tstate[e // 3] != T_MESHED or guard > T.nt:
             return -1
         pu = P(T, u)
@@ -175,7 +175,7 @@ cdef int _valence_split_point(Tri* T, int v, double* p) noexcept nogil:
             p[0] = pv[0] + SPLIT_AT * (pu[0] - pv[0])
             p[1] = pv[1] + SPLIT_AT * (pu[1] - pv[1])
         guard += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             return t
 
@@ -196,11 +196,11 @@ cdef bint _next_to_deficient(Tri* T, int v, int first_movable, int nv0,
     # this pass has added are not counted) is in SPLIT_DEFICIENT triangles or fewer
     cdef int e0 = T.vhe[v], e = e0, u, guard = 0
     while e0 >= 0 and guard <= T.nt:
-        u = T.tv[nxt(e)]
+        u = T.tv[nxt_nb(e)]
         if first_movable <= u < nv0 and n[u] <= SPLIT_DEFICIENT:
             return True
         guard += 1
-        e = T.twin[prv(e)]
+        e = T.twin[prv_nb(e)]
         if e == e0:
             break
     return False
