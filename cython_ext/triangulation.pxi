@@ -1,7 +1,7 @@
 # Half-edge triangulation: storage, flips, point location and point insertion.
 # Conventions: halfedge.pxd.  Geometry is only ever read through the predicates.
 #
-# Uses: halfedge.pxd (Tri, enums, nxt/prv, P, is_ghost, blocking); predicates.pxi
+# Uses: halfedge.pxd (Tri, enums, nxt_nb/prv_nb, P, is_ghost, blocking); predicates.pxi
 # (orient2d, incircle, surely_acute).
 from halfedge cimport *
 from libc.stdlib cimport malloc, realloc, free
