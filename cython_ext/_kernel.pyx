@@ -344,7 +344,7 @@ cdef class Triangulation:
         it is then found in a few steps (where it lands does not depend on the walk).
         Returns their vertex indices, or the earlier vertex at exactly the same
         place."""
-        cdef int m = points.shape[0], i, v, res = 0, start = NONE
+        cdef int m = points.shape[0], i, res = 0
         cdef bint hinted = near is not None
         if hinted and near.shape[0] != m:
             raise ValueError(f"near needs one vertex per point ({m}), got {near.shape[0]}")
@@ -352,14 +352,8 @@ cdef class Triangulation:
         cdef int32_t[::1] out = out_arr
         with nogil:
             for i in range(m):
-                start = NONE        # the walk's default start, unless near names one
-                if hinted and 0 <= near[i] < self.T.nv and self.T.vhe[near[i]] >= 0:
-                    start = tri_of(self.T.vhe[near[i]])
-                v = add_vertex(&self.T, points[i, 0], points[i, 1])
-                if v < 0:
-                    res = v
-                    break
-                res = insert_vertex(&self.T, v, start)
+                res = insert_point_near(&self.T, points[i, 0], points[i, 1],
+                                        near[i] if hinted else NONE)
                 if res < 0:
                     break
                 out[i] = res
@@ -1380,22 +1374,12 @@ def brio_keys_order(const double[:, ::1] xy, const int64_t[::1] rounds,
         return out_arr
     if n >= NOGIL_MIN_ITEMS:
         with nogil:
-            _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
+            brio_order_into(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0],
+                            &out[0])
     else:
-        _brio_order(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0], &out[0])
+        brio_order_into(&xy[0, 0], &rounds[0], n, bits, &keys[0], &order[0], &work[0],
+                        &out[0])
     return out_arr
-
-
-cdef void _brio_order(const double* xy, const int64_t* rounds, Py_ssize_t n, int bits,
-                      int64_t* keys, int64_t* order, int64_t* work,
-                      int32_t* out) noexcept nogil:
-    cdef Py_ssize_t i
-    hilbert_keys_into(xy, n, bits, keys)
-    for i in range(n):
-        keys[i] |= rounds[i]
-    stable_order(keys, _key_less, n, order, work)
-    for i in range(n):
-        out[i] = <int32_t> order[i]
 
 
 cdef int _check_discretize(const double[:, ::1] vertices, const int32_t[:, ::1] segments,

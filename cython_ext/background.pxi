@@ -3,8 +3,9 @@
 # its finite triangles, and the boundary's sizes spread over its edges at the
 # gradation rate, for one call of the def layer (background_field) that holds the
 # GIL only to make its arrays (src/aftmesh/sizing.py, make_size_field).  The pieces
-# also serve Triangulation.finite_triangles, Triangulation.edge_keys and
-# limit_gradation_mesh.
+# also serve Triangulation.finite_triangles, Triangulation.edge_keys,
+# limit_gradation_mesh, and with brio_order_into the BRIO order of brio_keys_order and
+# of resolve.pxi's midpoints.
 #
 # Uses: triangulation.pxi (Tri, tri_init, insert_points), ordering.pxi
 # (hilbert_keys_into), inputs.pxi (stable_order), sizing.pxi (limit_gradation_graph).
@@ -149,6 +150,21 @@ cdef int limit_gradation_tris(int nv, int nt, const double* xy, const int32_t* t
     return res
 
 
+cdef void brio_order_into(const double* xy, const int64_t* rounds, Py_ssize_t n,
+                          int bits, int64_t* keys, int64_t* order, int64_t* work,
+                          int32_t* out) noexcept nogil:
+    """The BRIO order of _order.brio_order into out (n indices): each point's round
+    key (rounds) over its Hilbert key (bits per coordinate), stably sorted; keys,
+    order and work are n each of scratch."""
+    cdef Py_ssize_t i
+    hilbert_keys_into(xy, n, bits, keys)
+    for i in range(n):
+        keys[i] |= rounds[i]
+    stable_order(keys, _key_less, n, order, work)
+    for i in range(n):
+        out[i] = <int32_t> order[i]
+
+
 cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds,
                      int32_t* merged) noexcept nogil:
     """Insert the n vertices of T (rows of xy) in the BRIO order of _order.brio_order
@@ -162,12 +178,8 @@ cdef int brio_insert(Tri* T, const double* xy, int n, const int64_t* rounds,
     if keys == NULL or order == NULL or work == NULL or order32 == NULL:
         res = ERR_NOMEM
     else:
-        hilbert_keys_into(xy, n, BRIO_HILBERT_BITS, keys)
+        brio_order_into(xy, rounds, n, BRIO_HILBERT_BITS, keys, order, work, order32)
         for i in range(n):
-            keys[i] |= rounds[i]
-        stable_order(keys, _key_less, n, order, work)
-        for i in range(n):
-            order32[i] = <int32_t> order[i]
             merged[i] = i
         res = insert_points(T, order32, n, merged)
     free(keys)

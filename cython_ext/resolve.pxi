@@ -9,11 +9,11 @@
 # Edges are int64 keys a n + b (a < b), sorted, as Triangulation.edge_keys gives them.
 #
 # Uses: for the rounds in one call (the end of this file), triangulation.pxi
-# (add_vertex, insert_vertex, _grow), background.pxi (finite_edge_keys,
-# BRIO_HILBERT_BITS), ordering.pxi (hilbert_keys_into), inputs.pxi (stable_order).
+# (insert_point_near, _grow), background.pxi (finite_edge_keys, brio_order_into,
+# BRIO_HILBERT_BITS).
 from libc.math cimport floor, log2, ldexp, fabs, sqrt
 from libc.stdlib cimport qsort, malloc, free
-from libc.stdint cimport int64_t
+from libc.stdint cimport int32_t, int64_t
 
 
 cdef int64_t keys_not_in(const int64_t* keys, int64_t m, const int64_t* passed, int64_t npass,
@@ -243,29 +243,26 @@ cdef int resolve_insert(Tri* T, Resolve* R, const double* mid, const double* um,
     round keys of n_keep points), each walk started at a triangle of its edge's first
     end, as Triangulation.add_points does; their sizes join R.u."""
     cdef int64_t i, j
-    cdef int v, res = 0, start, near, nv0 = T.nv
+    cdef int res = 0, nv0 = T.nv
     cdef double* xy = <double*> malloc((2 * n_keep + 1) * sizeof(double))
     cdef int64_t* keys = <int64_t*> malloc((3 * n_keep + 1) * sizeof(int64_t))
-    if xy == NULL or keys == NULL or _grow(<void**> &R.u, (nv0 + n_keep) * sizeof(double)):
-        free(xy)
-        free(keys)
-        return ERR_NOMEM
-    for i in range(n_keep):
-        xy[2 * i] = mid[2 * R.good[i]]
-        xy[2 * i + 1] = mid[2 * R.good[i] + 1]
-    hilbert_keys_into(xy, n_keep, BRIO_HILBERT_BITS, keys)
-    for i in range(n_keep):
-        keys[i] |= rounds[i]
-    stable_order(keys, _key_less, n_keep, &keys[n_keep], &keys[2 * n_keep])
-    for i in range(n_keep):
-        j = R.good[keys[n_keep + i]]
-        near = <int> R.ends[2 * j]
-        start = tri_of(T.vhe[near]) if 0 <= near < T.nv and T.vhe[near] >= 0 else NONE
-        v = add_vertex(T, mid[2 * j], mid[2 * j + 1])
-        res = v if v < 0 else insert_vertex(T, v, start)
-        if res < 0:
-            break
-        R.u[nv0 + i] = um[j]
+    cdef int32_t* order = <int32_t*> malloc((n_keep + 1) * sizeof(int32_t))
+    if (xy == NULL or keys == NULL or order == NULL
+            or _grow(<void**> &R.u, (nv0 + n_keep) * sizeof(double))):
+        res = ERR_NOMEM
+    else:
+        for i in range(n_keep):
+            xy[2 * i] = mid[2 * R.good[i]]
+            xy[2 * i + 1] = mid[2 * R.good[i] + 1]
+        brio_order_into(xy, rounds, n_keep, BRIO_HILBERT_BITS, keys, &keys[n_keep],
+                        &keys[2 * n_keep], order)
+        for i in range(n_keep):
+            j = R.good[order[i]]
+            res = insert_point_near(T, mid[2 * j], mid[2 * j + 1], <int> R.ends[2 * j])
+            if res < 0:
+                break
+            R.u[nv0 + i] = um[j]
     free(xy)
     free(keys)
+    free(order)
     return res if res < 0 else 0

@@ -577,6 +577,16 @@ cdef int insert_vertex(Tri* T, int v, int start) noexcept nogil:
     return v
 
 
+cdef int insert_point_near(Tri* T, double x, double y, int near) noexcept nogil:
+    """Append (x, y) as a vertex and insert it, its walk started at a triangle of
+    vertex `near` (a point close to it is then found in a few steps; NONE, or a vertex
+    in no triangle: locate's default start).  Returns insert_vertex's result."""
+    cdef int start = NONE, v
+    if 0 <= near < T.nv and T.vhe[near] >= 0:
+        start = tri_of(T.vhe[near])
+    v = add_vertex(T, x, y)
+    return v if v < 0 else insert_vertex(T, v, start)
+
 cdef int make_first_triangle(Tri* T, int a, int b, int c) noexcept nogil:
     """Start the triangulation with the non-degenerate triangle (a, b, c) and its three
     ghost triangles (a, b, c are put in counter-clockwise order here)."""
